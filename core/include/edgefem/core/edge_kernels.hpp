@@ -1,0 +1,179 @@
+// The edge-based StVK kernels (formulation.md): per-item workers that read
+// the model and write only the item's own outputs or one scatter target, and
+// serial loops over them. Parallel back-ends run the same workers over their
+// own index ranges. All vectors are xyz-interleaved (3 per vertex).
+//
+// Input is the displacement u = x - X, not the position: zeta is computed as
+// d.(2 r + d) with d = u(V0) - u(V1) and r the rest edge vector, which equals
+// |p~|^2 - H without its catastrophic cancellation at small strain.
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+#include "edgefem/core/edge_model.hpp"
+
+namespace edgefem {
+
+// Per-edge state of one evaluation: current edge vectors p~, zeta, g.
+template <class S>
+struct EdgeState {
+    std::vector<S> p;     // 3 #E
+    std::vector<S> zeta;  // #E
+    std::vector<S> g;     // #E
+    void resize(index_t num_edges) {
+        p.resize(3 * static_cast<std::size_t>(num_edges));
+        zeta.resize(num_edges);
+        g.resize(num_edges);
+    }
+};
+
+// Per-edge 3x3 blocks K(E) (row-major, 9 per edge) plus one sink block.
+template <class S>
+struct EdgeStiffness {
+    std::vector<S> K;  // 9 (#E + 1)
+    void resize(index_t num_edges) { K.assign(9 * (static_cast<std::size_t>(num_edges) + 1), S(0)); }
+};
+
+namespace kernel {
+
+// Edge loop worker: p~(E), zeta(E) and g(E) = L(E) zeta(E).
+template <class S>
+inline void edge_strain(const EdgeModel<S>& m, const S* __restrict u, index_t e, S* __restrict p,
+                        S* __restrict zeta, S* __restrict g) {
+    const index_t a = m.edge[e][0], b = m.edge[e][1];
+    const S* r = &m.rest[3 * std::size_t(e)];
+    const S d0 = u[3 * a] - u[3 * b], d1 = u[3 * a + 1] - u[3 * b + 1], d2 = u[3 * a + 2] - u[3 * b + 2];
+    const S q0 = r[0] + d0, q1 = r[1] + d1, q2 = r[2] + d2;
+    const S z = d0 * (r[0] + q0) + d1 * (r[1] + q1) + d2 * (r[2] + q2);
+    p[3 * std::size_t(e)] = q0;
+    p[3 * std::size_t(e) + 1] = q1;
+    p[3 * std::size_t(e) + 2] = q2;
+    zeta[e] = z;
+    g[e] = m.LE[e] * z;
+}
+
+// TSEP loop worker: the pair's contribution to g of both its edges.
+template <class S>
+inline void tsep_strain(const EdgeModel<S>& m, index_t P, const S* __restrict zeta, S* __restrict g) {
+    const index_t e0 = m.tsep[P][0], e1 = m.tsep[P][1];
+    const S L = m.LP[P];
+    g[e0] += L * zeta[e1];
+    g[e1] += L * zeta[e0];
+}
+
+// Edge scatter worker: f(V0) += p~ g, f(V1) -= p~ g.
+template <class S>
+inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, const S* __restrict g,
+                       S* __restrict f) {
+    const index_t a = m.edge[e][0], b = m.edge[e][1];
+    for (int r = 0; r < 3; ++r) {
+        const S v = p[3 * std::size_t(e) + r] * g[e];
+        f[3 * a + r] += v;
+        f[3 * b + r] -= v;
+    }
+}
+
+// Edge term of the stiffness: K(E) = -g I - 2 L(E) p~ p~^T (overwrites).
+template <class S>
+inline void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict p, const S* __restrict g,
+                           S* __restrict K) {
+    const S* q = &p[3 * std::size_t(e)];
+    S* k = &K[9 * std::size_t(e)];
+    const S c = -2 * m.LE[e];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) k[3 * i + j] = c * q[i] * q[j] - (i == j ? g[e] : S(0));
+}
+
+// TSEP term: Kp = 2 L(P) p~(E0) p~(E1)^T added with sign (-1)^(i+j) to its
+// targets, transposed where the target edge runs the other way.
+template <class S>
+inline void tsep_stiffness(const EdgeModel<S>& m, index_t P, const S* __restrict p, S* __restrict K) {
+    const S* p0 = &p[3 * std::size_t(m.tsep[P][0])];
+    const S* p1 = &p[3 * std::size_t(m.tsep[P][1])];
+    const S c = 2 * m.LP[P];
+    for (int k = 0; k < 4; ++k) {
+        const index_t t = m.target[P][k];
+        const bool tr = t & 1;
+        const S* x = tr ? p1 : p0;  // K(E2) += s c x y^T
+        const S* y = tr ? p0 : p1;
+        const S s = (k == 0 || k == 3) ? c : -c;
+        S* blk = &K[9 * std::size_t(t >> 1)];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) blk[3 * i + j] += s * x[i] * y[j];
+    }
+}
+
+// Matrix-free K x worker: d = x(V0) - x(V1); y(V0) -= K(E) d; y(V1) += K(E)^T d.
+template <class S>
+inline void edge_kx(const EdgeModel<S>& m, index_t e, const S* __restrict K, const S* __restrict x,
+                    S* __restrict y) {
+    const index_t a = m.edge[e][0], b = m.edge[e][1];
+    const S* k = &K[9 * std::size_t(e)];
+    const S d[3] = {x[3 * a] - x[3 * b], x[3 * a + 1] - x[3 * b + 1], x[3 * a + 2] - x[3 * b + 2]};
+    for (int i = 0; i < 3; ++i) {
+        y[3 * a + i] -= k[3 * i] * d[0] + k[3 * i + 1] * d[1] + k[3 * i + 2] * d[2];
+        y[3 * b + i] += k[i] * d[0] + k[3 + i] * d[1] + k[6 + i] * d[2];
+    }
+}
+
+// Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
+template <class S>
+inline void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict K, S* __restrict D) {
+    const index_t a = m.edge[e][0], b = m.edge[e][1];
+    const S* k = &K[9 * std::size_t(e)];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            D[9 * std::size_t(a) + 3 * i + j] -= k[3 * i + j];
+            D[9 * std::size_t(b) + 3 * i + j] -= k[3 * j + i];
+        }
+}
+
+}  // namespace kernel
+
+// ---- Serial reference loops -------------------------------------------------
+
+// Nodal forces f = dW/du (3 #V, overwritten; the internal force 'F(p)' of
+// M p'' + D p' + F(p) = h). Returns the energy W when `Energy`, else 0.
+// Leaves p~, zeta, g in `st` for edge_stiffness_all.
+template <ModelKind Kind, bool Energy, class S>
+double edge_forces(const EdgeModel<S>& m, const S* u, S* f, EdgeState<S>& st) {
+    const index_t ne = m.num_edges();
+    st.resize(ne);
+    for (index_t e = 0; e < ne; ++e) kernel::edge_strain(m, u, e, st.p.data(), st.zeta.data(), st.g.data());
+    if constexpr (Kind == ModelKind::FE)
+        for (index_t P = 0; P < m.num_tseps(); ++P) kernel::tsep_strain(m, P, st.zeta.data(), st.g.data());
+    std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
+    double W = 0;
+    for (index_t e = 0; e < ne; ++e) {
+        kernel::edge_force(m, e, st.p.data(), st.g.data(), f);
+        if constexpr (Energy) W += double(st.zeta[e]) * double(st.g[e]);
+    }
+    return 0.25 * W;
+}
+
+// Per-edge tangent stiffness from the state of the last edge_forces call.
+template <ModelKind Kind, class S>
+void edge_stiffness_all(const EdgeModel<S>& m, const EdgeState<S>& st, EdgeStiffness<S>& K) {
+    const index_t ne = m.num_edges();
+    if (K.K.size() != 9 * (std::size_t(ne) + 1)) K.resize(ne);
+    for (index_t e = 0; e < ne; ++e) kernel::edge_stiffness(m, e, st.p.data(), st.g.data(), K.K.data());
+    if constexpr (Kind == ModelKind::FE)
+        for (index_t P = 0; P < m.num_tseps(); ++P) kernel::tsep_stiffness(m, P, st.p.data(), K.K.data());
+}
+
+// y = K x (3 #V, overwritten).
+template <class S>
+void edge_multiply(const EdgeModel<S>& m, const EdgeStiffness<S>& K, const S* x, S* y) {
+    std::fill(y, y + 3 * std::size_t(m.num_vertices), S(0));
+    for (index_t e = 0; e < m.num_edges(); ++e) kernel::edge_kx(m, e, K.K.data(), x, y);
+}
+
+// The 3x3 diagonal blocks of K (9 #V, row-major, overwritten).
+template <class S>
+void edge_diagonal_blocks(const EdgeModel<S>& m, const EdgeStiffness<S>& K, S* D) {
+    std::fill(D, D + 9 * std::size_t(m.num_vertices), S(0));
+    for (index_t e = 0; e < m.num_edges(); ++e) kernel::edge_diagonal(m, e, K.K.data(), D);
+}
+
+}  // namespace edgefem

@@ -1,0 +1,19 @@
+// Generated box meshes: NX x NY x NZ cubes of side `cell`, each split into the
+// 6 Kuhn (Freudenthal) tets along its (0,0,0)->(1,1,1) diagonal, all positively
+// oriented. make_box(10, 5, 4) is the paper's 1,200-tet box.
+#pragma once
+
+#include "edgefem/core/mesh.hpp"
+
+namespace edgefem {
+
+// The box is centred at the origin. Vertex (i, j, k) has index
+// i + (NX+1) (j + (NY+1) k). Throws InvalidArgument for non-positive sizes or
+// more than 2^31-1 tets or vertices.
+Mesh make_box(index_t nx, index_t ny, index_t nz, double cell = 0.01);
+
+// A box of about `target_tets` tets with the paper box's 5:2.5:2 aspect
+// (cells of 0.1 / nx m); used as a stand-in when a named mesh is absent.
+Mesh make_box_of_size(double target_tets);
+
+}  // namespace edgefem
