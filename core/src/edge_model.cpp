@@ -5,7 +5,7 @@ namespace edgefem {
 template <class S>
 double EdgeModel<S>::bytes_per_tet(bool with_stiffness) const {
     const double bytes = edge.size() * sizeof(edge[0]) + rest.size() * sizeof(S) + LE.size() * sizeof(S) +
-                         tsep.size() * sizeof(tsep[0]) + LP.size() * sizeof(S) +
+                         tsep_first.size() * sizeof(index_t) + tsep_other.size() * sizeof(index_t) + LP.size() * sizeof(S) +
                          (with_stiffness ? target.size() * sizeof(target[0]) : 0);
     return num_tets > 0 ? bytes / num_tets : 0.0;
 }
@@ -18,7 +18,9 @@ EdgeModel<S> make_edge_model(const Topology& topo, const Coefficients& coef) {
     m.edge = topo.edges;
     m.rest.assign(coef.rest_edge.begin(), coef.rest_edge.end());
     m.LE.assign(coef.LE.begin(), coef.LE.end());
-    m.tsep = topo.tseps;
+    m.tsep_first = topo.first_tsep;
+    m.tsep_other.resize(topo.tseps.size());
+    for (std::size_t p = 0; p < topo.tseps.size(); ++p) m.tsep_other[p] = topo.tseps[p][1];
     m.LP.assign(coef.LP.begin(), coef.LP.end());
     const index_t sink = topo.num_edges() << 1;
     m.target.resize(topo.tsep_targets.size());

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "edgefem/core/mesh.hpp"
+#include "edgefem/core/named_mesh.hpp"
 
 namespace edgefem::test {
 
@@ -14,20 +15,14 @@ struct NamedMesh {
     Mesh mesh;
 };
 
-// Folder of the shared meshes (EDGEFEM_SHARED_MESHES env var overrides).
+// Folder of the shared meshes ($EDGEFEM_MESH_DIR overrides).
 std::string shared_mesh_dir();
 // Path prefix of a shared TetGen mesh ("<dir>/bunny-4k"), or "" if absent.
 std::string shared_mesh_prefix(const std::string& name);
 // Folder with the small test files kept in tests/data.
 std::string test_data_dir();
 
-// Names of the shared meshes, smallest first, with their tet counts from
-// ../shared/meshes/README.md.
-struct SharedMeshInfo {
-    const char* name;
-    long vertices, tets, edges, tseps;
-};
-const std::vector<SharedMeshInfo>& shared_mesh_table();
+inline const std::vector<NamedMeshInfo>& shared_mesh_table() { return named_mesh_table(); }
 
 // Generated boxes (1x1x1, the paper's 10x5x4, a 3x4x5 box) plus every shared
 // mesh with at most `max_tets` tets that is present.

@@ -57,13 +57,20 @@ inline void edge_strain(const EdgeModel<S>& m, const S* __restrict u, index_t e,
     g[e] = m.LE[e] * z;
 }
 
-// TSEP loop worker: the pair's contribution to g of both its edges.
+// TSEP loop worker for the segment of TSEPs whose first edge is e0: each
+// pair adds L(P) zeta(E1) to g(E0) and L(P) zeta(E0) to g(E1). The E1 of a
+// segment are distinct and greater than e0, so nothing inside it aliases.
 template <class S>
-inline void tsep_strain(const EdgeModel<S>& m, index_t P, const S* __restrict zeta, double* __restrict g) {
-    const index_t e0 = m.tsep[P][0], e1 = m.tsep[P][1];
-    const double L = m.LP[P];
-    g[e0] += L * zeta[e1];
-    g[e1] += L * zeta[e0];
+inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g) {
+    const double z0 = zeta[e0];
+    double acc = 0;
+    for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
+        const index_t e1 = m.tsep_other[P];
+        const double L = m.LP[P];
+        acc += L * double(zeta[e1]);
+        g[e1] += L * z0;
+    }
+    g[e0] += acc;
 }
 
 // Edge scatter worker: f(V0) += p~ g, f(V1) -= p~ g.
@@ -89,22 +96,31 @@ inline void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict
         for (int j = 0; j < 3; ++j) k[3 * i + j] = c * q[i] * q[j] - (i == j ? S(g[e]) : S(0));
 }
 
-// TSEP term: Kp = 2 L(P) p~(E0) p~(E1)^T added with sign (-1)^(i+j) to its
-// targets, transposed where the target edge runs the other way.
+// TSEP term for the segment of first edge e0: Kp = 2 L(P) p~(E0) p~(E1)^T
+// added with sign (-1)^(i+j) to each of its 4 targets, transposed where the
+// target edge runs the other way. Kp and Kp^T sit side by side so the
+// transpose flag picks one by index arithmetic, not by a branch.
 template <class S>
-inline void tsep_stiffness(const EdgeModel<S>& m, index_t P, const S* __restrict p, S* __restrict K) {
-    const S* p0 = &p[3 * std::size_t(m.tsep[P][0])];
-    const S* p1 = &p[3 * std::size_t(m.tsep[P][1])];
-    const S c = 2 * m.LP[P];
-    for (int k = 0; k < 4; ++k) {
-        const index_t t = m.target[P][k];
-        const bool tr = t & 1;
-        const S* x = tr ? p1 : p0;  // K(E2) += s c x y^T
-        const S* y = tr ? p0 : p1;
-        const S s = (k == 0 || k == 3) ? c : -c;
-        S* blk = &K[9 * std::size_t(t >> 1)];
+inline void tsep_stiffness_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict p, S* __restrict K) {
+    const S* p0 = &p[3 * std::size_t(e0)];
+    for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
+        const S* p1 = &p[3 * std::size_t(m.tsep_other[P])];
+        const S c = 2 * m.LP[P];
+        S kp[18];
         for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) blk[3 * i + j] += s * x[i] * y[j];
+            for (int j = 0; j < 3; ++j) {
+                kp[3 * i + j] = c * p0[i] * p1[j];
+                kp[9 + 3 * j + i] = kp[3 * i + j];
+            }
+        for (int k = 0; k < 4; ++k) {
+            const index_t t = m.target[P][k];
+            const S* src = kp + 9 * (t & 1);
+            S* blk = &K[9 * std::size_t(t >> 1)];
+            if (k == 0 || k == 3)
+                for (int i = 0; i < 9; ++i) blk[i] += src[i];
+            else
+                for (int i = 0; i < 9; ++i) blk[i] -= src[i];
+        }
     }
 }
 
@@ -146,7 +162,7 @@ double edge_forces(const EdgeModel<S>& m, const S* u, S* f, EdgeState<S>& st) {
     st.resize(ne);
     for (index_t e = 0; e < ne; ++e) kernel::edge_strain(m, u, e, st.p.data(), st.zeta.data(), st.g.data());
     if constexpr (Kind == ModelKind::FE)
-        for (index_t P = 0; P < m.num_tseps(); ++P) kernel::tsep_strain(m, P, st.zeta.data(), st.g.data());
+        for (index_t e = 0; e < ne; ++e) kernel::tsep_strain_segment(m, e, st.zeta.data(), st.g.data());
     std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
     double W = 0;
     for (index_t e = 0; e < ne; ++e) {
@@ -163,7 +179,7 @@ void edge_stiffness_all(const EdgeModel<S>& m, const EdgeState<S>& st, EdgeStiff
     if (K.K.size() != 9 * (std::size_t(ne) + 1)) K.resize(ne);
     for (index_t e = 0; e < ne; ++e) kernel::edge_stiffness(m, e, st.p.data(), st.g.data(), K.K.data());
     if constexpr (Kind == ModelKind::FE)
-        for (index_t P = 0; P < m.num_tseps(); ++P) kernel::tsep_stiffness(m, P, st.p.data(), K.K.data());
+        for (index_t e = 0; e < ne; ++e) kernel::tsep_stiffness_segment(m, e, st.p.data(), K.K.data());
 }
 
 // y = K x (3 #V, overwritten).

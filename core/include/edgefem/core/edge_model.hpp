@@ -24,7 +24,12 @@ struct EdgeModel {
     std::vector<std::array<index_t, 2>> edge;  // #E {V0, V1}
     std::vector<S> rest;                       // 3 #E rest edge vectors X(V0) - X(V1)
     std::vector<S> LE;                         // #E L(E)
-    std::vector<std::array<index_t, 2>> tsep;  // #P {E0, E1}
+    // TSEPs are held in segments by their first edge E0 (they are sorted by
+    // it): the TSEPs with E0 = e are tsep_first[e] .. tsep_first[e+1], and
+    // only E1 is stored. A segment accumulates g(E0) in a register instead of
+    // chaining stores to the same g(E0), and E0 costs no bytes.
+    std::vector<index_t> tsep_first;           // #E + 1
+    std::vector<index_t> tsep_other;           // #P E1
     std::vector<S> LP;                         // #P L(P)
     // #P stiffness targets (E2 << 1 | transposed) for slots k = 2i + j; a
     // diagonal target points at the sink block #E, so the stiffness loop has
@@ -32,7 +37,7 @@ struct EdgeModel {
     std::vector<std::array<index_t, 4>> target;
 
     index_t num_edges() const { return static_cast<index_t>(edge.size()); }
-    index_t num_tseps() const { return static_cast<index_t>(tsep.size()); }
+    index_t num_tseps() const { return static_cast<index_t>(tsep_other.size()); }
     // Bytes of precomputed model data (everything above) per tet, with and
     // without the stiffness targets (force-only use needs no targets).
     double bytes_per_tet(bool with_stiffness = true) const;

@@ -1,0 +1,332 @@
+#include "common.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/make_box.hpp"
+#include "edgefem/core/tet_kernels.hpp"
+#include "edgefem/core/topology.hpp"
+
+namespace edgefem::cli {
+
+// ---- Mesh ---------------------------------------------------------------
+
+void add_mesh_options(CLI::App& cmd, MeshOptions& opts) {
+    cmd.add_option("MESH", opts.path,
+                   "Mesh: a TetGen .node or .ele file or their common prefix, a Gmsh .msh, MEDIT .mesh "
+                   "or Vega .veg file, or the built-in box:NXxNYxNZ (NX x NY x NZ cubes of 0.01 m, "
+                   "6 tets each; box:10x5x4 is the paper's 1,200-tet box)")
+        ->required();
+    cmd.add_flag("--fix-orientation", opts.fix_orientation,
+                 "Reorient negatively oriented tets instead of rejecting the mesh");
+    cmd.add_flag("--compact", opts.compact, "Remove vertices that no tet uses");
+}
+
+namespace {
+
+constexpr const char* kBoxPrefix = "box:";
+
+// "box:NXxNYxNZ" -> make_box; the whole spec must parse.
+Mesh make_box_from_spec(const std::string& spec) {
+    const auto bad = [&] {
+        return InvalidArgument("bad box mesh '" + spec + "': expected box:NXxNYxNZ with positive integers, e.g. box:10x5x4");
+    };
+    index_t n[3];
+    const char* p = spec.data() + std::strlen(kBoxPrefix);
+    const char* end = spec.data() + spec.size();
+    for (int i = 0; i < 3; ++i) {
+        const auto [next, ec] = std::from_chars(p, end, n[i]);
+        if (ec != std::errc() || n[i] <= 0) throw bad();
+        p = next;
+        if (i < 2) {
+            if (p == end || (*p != 'x' && *p != 'X')) throw bad();
+            ++p;
+        }
+    }
+    if (p != end) throw bad();
+    return make_box(n[0], n[1], n[2]);
+}
+
+}  // namespace
+
+LoadedMesh load_mesh(const MeshOptions& opts) {
+    LoadedMesh m;
+    if (opts.path.rfind(kBoxPrefix, 0) == 0)
+        m.mesh = make_box_from_spec(opts.path);
+    else
+        m.mesh = read_mesh(opts.path, MeshFormat::Auto, &m.read);
+    ValidationOptions v;
+    v.fix_orientation = opts.fix_orientation;
+    v.compact_unreferenced = opts.compact;
+    m.validation = validate_mesh(m.mesh, v);
+    return m;
+}
+
+std::vector<std::string> load_warnings(const LoadedMesh& m) {
+    std::vector<std::string> w = m.read.warnings;
+    w.insert(w.end(), m.validation.warnings.begin(), m.validation.warnings.end());
+    return w;
+}
+
+// ---- Model --------------------------------------------------------------
+
+void ModelOptions::validate() const {
+    material.validate();
+    if (method_kind() == Method::Tet && kind() == ModelKind::SN)
+        throw InvalidArgument("--method tet supports only --model fe (the spring network is edge-based only)");
+}
+
+void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required) {
+    cmd.add_option("--model", opts.model, "fe: the StVK tet element; sn: the nonlinear spring network")
+        ->check(CLI::IsMember({"fe", "sn"}))
+        ->capture_default_str();
+    cmd.add_option("--method", opts.method, "edge: the edge-based kernels; tet: the conventional per-tet method (fe only)")
+        ->check(CLI::IsMember({"edge", "tet"}))
+        ->capture_default_str();
+    cmd.add_option("--precision", opts.precision, "Scalar type of the kernels")
+        ->check(CLI::IsMember({"double", "float"}))
+        ->capture_default_str();
+    auto* young = cmd.add_option("--young", opts.material.young, "Young's modulus (Pa)");
+    auto* poisson = cmd.add_option("--poisson", opts.material.poisson, "Poisson ratio, in (-1, 0.5)");
+    if (material_required) {
+        young->required();
+        poisson->required();
+    } else {
+        young->capture_default_str();
+        poisson->capture_default_str();
+    }
+    cmd.add_option("--density", opts.material.density, "Density (kg/m^3)")->capture_default_str();
+}
+
+namespace {
+
+// Tells the compiler that the memory behind p is read, so the stores of the
+// timed call cannot be dropped.
+inline void escape(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
+
+// Converts between double (the interface) and the kernel's scalar type.
+template <class From, class To>
+void cast_into(const std::vector<From>& in, std::vector<To>& out) {
+    out.assign(in.begin(), in.end());
+}
+
+template <class S, ModelKind Kind>
+class EdgeEvaluator final : public Evaluator {
+public:
+    EdgeEvaluator(const Mesh& mesh, const Materials& mat) {
+        const Topology topo = build_topology(mesh);
+        model_ = make_edge_model<S>(topo, compute_coefficients(mesh, topo, mat));
+        const std::size_t n = 3 * std::size_t(model_.num_vertices);
+        u_.assign(n, S(0));
+        f_.assign(n, S(0));
+        x_.assign(n, S(0));
+        y_.assign(n, S(0));
+    }
+
+    void set_displacement(const std::vector<double>& u) override { cast_into(u, u_); }
+
+    double energy_forces(std::vector<double>& f) override {
+        const double W = edge_forces<Kind, true>(model_, u_.data(), f_.data(), state_);
+        cast_into(f_, f);
+        return W;
+    }
+
+    void stiffness_times(const std::vector<double>& x, std::vector<double>& y) override {
+        prepare(Kernel::Kx, x);
+        run(Kernel::Kx);
+        cast_into(y_, y);
+    }
+
+    void prepare(Kernel kernel, const std::vector<double>& x) override {
+        cast_into(x, x_);
+        // stiffness and kx start from the state of a force call; kx also
+        // from a precomputed K.
+        if (kernel == Kernel::Stiffness || kernel == Kernel::Kx)
+            edge_forces<Kind, false>(model_, u_.data(), f_.data(), state_);
+        if (kernel == Kernel::Kx) edge_stiffness_all<Kind>(model_, state_, K_);
+    }
+
+    void run(Kernel kernel) override {
+        switch (kernel) {
+            case Kernel::Force: edge_forces<Kind, false>(model_, u_.data(), f_.data(), state_); break;
+            case Kernel::Stiffness: edge_stiffness_all<Kind>(model_, state_, K_); break;
+            case Kernel::ForceStiffness:
+                edge_forces<Kind, false>(model_, u_.data(), f_.data(), state_);
+                edge_stiffness_all<Kind>(model_, state_, K_);
+                break;
+            case Kernel::Kx: edge_multiply(model_, K_, x_.data(), y_.data()); break;
+        }
+    }
+
+    void consume() override {
+        escape(f_.data());
+        escape(K_.K.data());
+        escape(y_.data());
+    }
+
+private:
+    EdgeModel<S> model_;
+    EdgeState<S> state_;
+    EdgeStiffness<S> K_;
+    std::vector<S> u_, f_, x_, y_;
+};
+
+template <class S>
+class TetEvaluator final : public Evaluator {
+public:
+    TetEvaluator(const Mesh& mesh, const Materials& mat) : model_(make_tet_model<S>(mesh, mat)) {
+        const std::size_t n = 3 * std::size_t(model_.num_vertices);
+        u_.assign(n, S(0));
+        f_.assign(n, S(0));
+        x_.assign(n, S(0));
+        y_.assign(n, S(0));
+    }
+
+    void set_displacement(const std::vector<double>& u) override { cast_into(u, u_); }
+
+    double energy_forces(std::vector<double>& f) override {
+        const double W = tet_forces<true>(model_, u_.data(), f_.data());
+        cast_into(f_, f);
+        return W;
+    }
+
+    void stiffness_times(const std::vector<double>& x, std::vector<double>& y) override {
+        prepare(Kernel::Kx, x);
+        run(Kernel::Kx);
+        cast_into(y_, y);
+    }
+
+    void prepare(Kernel kernel, const std::vector<double>& x) override {
+        cast_into(x, x_);
+        // kx multiplies with stored per-tet blocks.
+        if (kernel == Kernel::Kx) tet_stiffness_all(model_, u_.data(), K_);
+    }
+
+    void run(Kernel kernel) override {
+        switch (kernel) {
+            case Kernel::Force: tet_forces<false>(model_, u_.data(), f_.data()); break;
+            case Kernel::Stiffness: tet_stiffness_all(model_, u_.data(), K_); break;
+            case Kernel::ForceStiffness: tet_forces_stiffness<false>(model_, u_.data(), f_.data(), K_); break;
+            case Kernel::Kx: tet_multiply(model_, K_, x_.data(), y_.data()); break;
+        }
+    }
+
+    void consume() override {
+        escape(f_.data());
+        escape(K_.K.data());
+        escape(y_.data());
+    }
+
+private:
+    TetModel<S> model_;
+    TetStiffness<S> K_;
+    std::vector<S> u_, f_, x_, y_;
+};
+
+template <class S>
+std::unique_ptr<Evaluator> make_evaluator_as(const Mesh& mesh, const ModelOptions& opts) {
+    const Materials mat(opts.material);
+    if (opts.method_kind() == Method::Tet) return std::make_unique<TetEvaluator<S>>(mesh, mat);
+    if (opts.kind() == ModelKind::SN) return std::make_unique<EdgeEvaluator<S, ModelKind::SN>>(mesh, mat);
+    return std::make_unique<EdgeEvaluator<S, ModelKind::FE>>(mesh, mat);
+}
+
+}  // namespace
+
+std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts) {
+    if (opts.precision_kind() == Precision::Float) return make_evaluator_as<float>(mesh, opts);
+    return make_evaluator_as<double>(mesh, opts);
+}
+
+// ---- Text I/O -------------------------------------------------------------
+
+namespace {
+
+std::string where(const std::string& path, std::int64_t line) {
+    return line > 0 ? path + ":" + std::to_string(line) + ": " : path + ": ";
+}
+
+// One number token; from_chars does not take a leading '+'.
+bool parse_double(std::string_view tok, double& out) {
+    if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
+    const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
+    return ec == std::errc() && end == tok.data() + tok.size();
+}
+
+}  // namespace
+
+std::vector<double> read_vectors(const std::string& path, index_t count) {
+    std::ifstream in(path);
+    if (!in) throw Error(path + ": cannot open file: " + std::strerror(errno));
+    std::vector<double> v;
+    v.reserve(3 * std::size_t(count));
+    std::string text;
+    std::int64_t line = 0;
+    while (std::getline(in, text)) {
+        ++line;
+        std::istringstream tokens(text);
+        std::vector<std::string> tok;
+        for (std::string t; tokens >> t;) tok.push_back(t);
+        if (tok.empty()) continue;  // blank line
+        if (v.size() == 3 * std::size_t(count))
+            throw Error(where(path, line) + "more lines than the mesh's " + std::to_string(count) + " vertices");
+        if (tok.size() != 3)
+            throw Error(where(path, line) + "expected 3 numbers 'x y z', found " + std::to_string(tok.size()) +
+                        " fields");
+        for (const auto& t : tok) {
+            double x;
+            if (!parse_double(t, x)) throw Error(where(path, line) + "not a number: '" + t + "'");
+            if (!std::isfinite(x)) throw Error(where(path, line) + "non-finite value: '" + t + "'");
+            v.push_back(x);
+        }
+    }
+    if (in.bad()) throw Error(path + ": read error");
+    if (v.size() != 3 * std::size_t(count))
+        throw Error(where(path, line) + "file ends after " + std::to_string(v.size() / 3) + " lines, expected " +
+                    std::to_string(count) + " (one per vertex)");
+    return v;
+}
+
+namespace {
+
+// Writes via stdio so that %.17g is exact; throws Error on any failure.
+template <class Body>
+void write_file(const std::string& path, Body body) {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    if (!f) throw Error(path + ": cannot write file: " + std::strerror(errno));
+    body(f);
+    const bool failed = std::ferror(f) != 0;
+    if (std::fclose(f) != 0 || failed) throw Error(path + ": write failed");
+}
+
+}  // namespace
+
+void write_vectors(const std::string& path, const std::vector<double>& v) {
+    write_file(path, [&](std::FILE* f) {
+        for (std::size_t i = 0; i + 2 < v.size(); i += 3) std::fprintf(f, "%.17g %.17g %.17g\n", v[i], v[i + 1], v[i + 2]);
+    });
+}
+
+void write_scalar(const std::string& path, double value) {
+    write_file(path, [&](std::FILE* f) { std::fprintf(f, "%.17g\n", value); });
+}
+
+std::string fmt(double value, int digits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+    return buf;
+}
+
+void print_kv(const std::string& key, const std::string& value) { std::printf("%s: %s\n", key.c_str(), value.c_str()); }
+
+void print_kv(const std::string& key, double value) { print_kv(key, fmt(value)); }
+
+}  // namespace edgefem::cli

@@ -1,0 +1,125 @@
+// What the edgefem subcommands share: mesh loading (files or box:NXxNYxNZ),
+// the model/method/precision options, one evaluator interface over the
+// edge-based and per-tet kernels, and the text I/O. Every formula lives in
+// core/; this only wires it.
+#pragma once
+
+#include <concepts>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/material.hpp"
+#include "edgefem/core/mesh.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/validate_mesh.hpp"
+
+namespace edgefem::cli {
+
+// ---- Mesh ---------------------------------------------------------------
+
+struct MeshOptions {
+    std::string path;  // file, TetGen prefix or box:NXxNYxNZ
+    bool fix_orientation = false;
+    bool compact = false;
+};
+
+struct LoadedMesh {
+    Mesh mesh;
+    ReadReport read;              // empty for a generated box
+    ValidationReport validation;
+};
+
+// Adds the MESH positional and --fix-orientation / --compact.
+void add_mesh_options(CLI::App& cmd, MeshOptions& opts);
+
+// Reads (or generates) and validates the mesh; throws edgefem::Error.
+LoadedMesh load_mesh(const MeshOptions& opts);
+
+// Reader and validation warnings, one "<prefix><text>" line each.
+std::vector<std::string> load_warnings(const LoadedMesh& m);
+
+// ---- Model --------------------------------------------------------------
+
+enum class Method { Edge, Tet };
+enum class Precision { Double, Float };
+
+struct ModelOptions {
+    std::string model = "fe";         // fe | sn
+    std::string method = "edge";      // edge | tet
+    std::string precision = "double"; // double | float
+    Material material;
+
+    ModelKind kind() const { return model == "sn" ? ModelKind::SN : ModelKind::FE; }
+    Method method_kind() const { return method == "tet" ? Method::Tet : Method::Edge; }
+    Precision precision_kind() const { return precision == "float" ? Precision::Float : Precision::Double; }
+    // Throws InvalidArgument for an invalid material or --method tet --model sn.
+    void validate() const;
+};
+
+// Adds --model, --method, --precision, --young, --poisson, --density.
+// `material_required`: --young/--poisson must be given (forces) or default
+// to the Material defaults (bench).
+void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required);
+
+// The kernels `bench` times (see its --help).
+enum class Kernel { Force, Stiffness, ForceStiffness, Kx };
+
+// One model (edge FE/SN or per-tet, float or double) behind one interface.
+// Inputs and outputs are double; the kernel's precision is used inside, so
+// the conversions happen once, outside the timed calls.
+class Evaluator {
+public:
+    virtual ~Evaluator() = default;
+    // The configuration as a displacement u = x - X (3 #V).
+    virtual void set_displacement(const std::vector<double>& u) = 0;
+    // Energy and forces f = dW/du at the current configuration.
+    virtual double energy_forces(std::vector<double>& f) = 0;
+    // y = K x at the current configuration (builds K).
+    virtual void stiffness_times(const std::vector<double>& x, std::vector<double>& y) = 0;
+
+    // Benchmarking: prepare() sets up what `kernel` needs (the force state
+    // or a precomputed K, and x for kx) untimed; run() makes one call;
+    // consume() keeps the optimiser from dropping the work.
+    virtual void prepare(Kernel kernel, const std::vector<double>& x) = 0;
+    virtual void run(Kernel kernel) = 0;
+    virtual void consume() = 0;
+};
+
+// Builds the chosen model for `mesh` (opts must be validated).
+std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts);
+
+// ---- Text I/O -------------------------------------------------------------
+
+// Reads one 'x y z' line per vertex (blank lines ignored); throws Error
+// naming the file and line on a wrong line count, a non-numeric or a
+// non-finite value.
+std::vector<double> read_vectors(const std::string& path, index_t count);
+
+// One 'x y z' line per vertex, %.17g each.
+void write_vectors(const std::string& path, const std::vector<double>& v);
+// One number, %.17g.
+void write_scalar(const std::string& path, double value);
+
+// %.<digits>g; 17 digits (the default) round-trip a double exactly.
+std::string fmt(double value, int digits = 17);
+// Prints "key: value".
+void print_kv(const std::string& key, const std::string& value);
+void print_kv(const std::string& key, double value);
+template <std::integral T>
+void print_kv(const std::string& key, T value) {
+    print_kv(key, std::to_string(value));
+}
+
+// ---- Subcommands (cmd_*.cpp) ----------------------------------------------
+
+// Each adds its subcommand to `app` with a callback that runs it; errors
+// propagate as exceptions to main.
+void add_info_command(CLI::App& app);
+void add_forces_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+
+}  // namespace edgefem::cli

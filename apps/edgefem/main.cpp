@@ -1,0 +1,59 @@
+// edgefem: command-line front end of the edgefem library. Every error is one
+// line "edgefem: error: <message>" on stderr and exit code 2.
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "common.hpp"
+
+namespace {
+
+constexpr int kErrorExit = 2;
+
+int fail(std::string message) {
+    // One line, whatever the message holds.
+    for (char& c : message)
+        if (c == '\n' || c == '\r') c = ' ';
+    std::fprintf(stderr, "edgefem: error: %s\n", message.c_str());
+    return kErrorExit;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"edgefem " EDGEFEM_VERSION
+                 ": edge-based StVK tetrahedral FEM (Kikuuwe et al. 2009) and the per-tet baseline",
+                 "edgefem"};
+    app.set_version_flag("--version", EDGEFEM_VERSION);
+    app.require_subcommand(1);
+    app.footer(
+        "MESH is a TetGen .node/.ele file or their common prefix, a Gmsh .msh, MEDIT .mesh or Vega .veg\n"
+        "file, or box:NXxNYxNZ, a generated box of NX x NY x NZ cubes of 0.01 m split into 6 tets each\n"
+        "(box:10x5x4 is the paper's 1,200-tet box), so no files are needed:\n"
+        "  edgefem info box:10x5x4\n"
+        "  edgefem forces box:10x5x4 --young 1e5 --poisson 0.3 --deform twist --out twist\n"
+        "  edgefem bench box:10x5x4 --kernel force --method tet\n"
+        "Errors print one line 'edgefem: error: ...' to stderr and exit with code 2.");
+    edgefem::cli::add_info_command(app);
+    edgefem::cli::add_forces_command(app);
+    edgefem::cli::add_bench_command(app);
+    // CLI11 would report a mistyped subcommand as "A subcommand is required".
+    if (argc > 1 && argv[1][0] != '-') {
+        bool known = false;
+        for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+            known = known || sub->get_name() == argv[1];
+        if (!known) return fail(std::string("unknown subcommand '") + argv[1] + "' (expected info, forces or bench)");
+    }
+    try {
+        app.parse(argc, argv);  // runs the selected subcommand's callback
+    } catch (const CLI::Success& e) {
+        return app.exit(e);  // --help, --version
+    } catch (const CLI::ParseError& e) {
+        return fail(e.what());
+    } catch (const std::exception& e) {
+        return fail(e.what());
+    }
+    return 0;
+}
