@@ -1,0 +1,394 @@
+// Gmsh MSH 2.2 and 4.1 ASCII reader. Nodes keep file order and may have any
+// positive, non-contiguous tags; elements other than 4-node tets are skipped
+// and counted. Tets are resolved against the node tags once the whole file
+// is read, so section order does not matter.
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "text_reader.hpp"
+
+namespace edgefem {
+
+namespace {
+
+constexpr int kTetType = 4;
+
+std::string element_type_name(std::int64_t type) {
+    static const std::map<std::int64_t, const char*> names = {
+        {1, "line"},
+        {2, "triangle"},
+        {3, "quadrangle"},
+        {4, "tetrahedron"},
+        {5, "hexahedron"},
+        {6, "prism"},
+        {7, "pyramid"},
+        {8, "3-node line"},
+        {9, "6-node triangle"},
+        {10, "9-node quadrangle"},
+        {11, "10-node tetrahedron"},
+        {12, "27-node hexahedron"},
+        {13, "18-node prism"},
+        {14, "14-node pyramid"},
+        {15, "point"},
+        {16, "8-node quadrangle"},
+        {17, "20-node hexahedron"},
+        {18, "15-node prism"},
+        {19, "13-node pyramid"},
+    };
+    const auto it = names.find(type);
+    return it == names.end() ? "element" : it->second;
+}
+
+struct GmshData {
+    int version = 0;  // 2 or 41
+    bool have_nodes = false, have_elements = false;
+    Mesh mesh;
+    std::vector<std::int64_t> node_tag_line;  // line of each node's tag (4.1: the tag line)
+    std::vector<std::int64_t> tet_nodes;      // 4 node tags per tet
+    std::vector<int> tet_entity_dim;          // 4.1: dimension of the tet's entity
+    std::vector<std::int64_t> tet_entity;     // 4.1: entity tag of the tet's block
+    std::unordered_map<std::int64_t, std::int64_t> volume_physical;  // 4.1 $Entities
+    std::map<std::int64_t, std::int64_t> skipped;                      // type -> count
+};
+
+std::int64_t single_int(detail::TextReader& r, const std::string& what) {
+    r.require_line(what);
+    auto tk = r.tokens();
+    const std::int64_t v = r.next_int(tk, what);
+    r.expect_end(tk, what);
+    return v;
+}
+
+void expect_line(detail::TextReader& r, const std::string& expected, const std::string& context) {
+    r.require_line("'" + expected + "'");
+    if (r.line() != expected)
+        r.fail("expected '" + expected + "' " + context + ", got '" +
+               detail::quote(r.line()) + "'");
+}
+
+int region_from_tag(const detail::TextReader& r, std::int64_t tag) {
+    if (tag < std::numeric_limits<int>::min() || tag > std::numeric_limits<int>::max())
+        r.fail("physical tag " + std::to_string(tag) + " does not fit an int region id");
+    return static_cast<int>(tag);
+}
+
+void add_node(detail::TextReader& r, GmshData& d, std::int64_t tag, std::int64_t tag_line,
+              detail::LineTokens& tk, int extra_allowed) {
+    auto& m = d.mesh;
+    const index_t v = m.num_vertices();
+    if (tag < 1) r.fail_at(tag_line, "node tag " + std::to_string(tag) + " must be positive", v);
+    double p[3];
+    p[0] = r.next_double(tk, "x coordinate");
+    p[1] = r.next_double(tk, "y coordinate");
+    p[2] = r.next_double(tk, "z coordinate");
+    for (int k = 0; k < extra_allowed && !tk.empty(); ++k) r.next_double(tk, "parametric coordinate");
+    r.expect_end(tk, "the coordinates of node " + std::to_string(tag));
+    detail::check_finite(r, p, v, tag);
+    m.X.insert(m.X.end(), p, p + 3);
+    m.source.vertex_line.push_back(r.line_no());
+    m.source.vertex_id.push_back(tag);
+    d.node_tag_line.push_back(tag_line);
+}
+
+void add_tet(detail::TextReader& r, GmshData& d, std::int64_t tag, detail::LineTokens& tk,
+             int region, int entity_dim, std::int64_t entity) {
+    for (int k = 0; k < 4; ++k) d.tet_nodes.push_back(r.next_int(tk, "tet node tag"));
+    r.expect_end(tk, "the 4 nodes of tetrahedron " + std::to_string(tag));
+    d.mesh.region.push_back(region);
+    d.mesh.source.tet_line.push_back(r.line_no());
+    d.mesh.source.tet_id.push_back(tag);
+    d.tet_entity_dim.push_back(entity_dim);
+    d.tet_entity.push_back(entity);
+}
+
+void read_nodes_22(detail::TextReader& r, GmshData& d) {
+    const index_t n = r.check_count(single_int(r, "the node count"), 4, "node");
+    d.mesh.X.reserve(3 * static_cast<std::size_t>(n));
+    for (index_t i = 0; i < n; ++i) {
+        r.require_line("node " + std::to_string(i + 1) + " of " + std::to_string(n));
+        auto tk = r.tokens();
+        const std::int64_t tag = r.next_int(tk, "node tag");
+        add_node(r, d, tag, r.line_no(), tk, 0);
+    }
+    expect_line(r, "$EndNodes", "after " + std::to_string(n) + " nodes");
+}
+
+void read_elements_22(detail::TextReader& r, GmshData& d) {
+    const index_t n = r.check_count(single_int(r, "the element count"), 3, "element");
+    for (index_t i = 0; i < n; ++i) {
+        r.require_line("element " + std::to_string(i + 1) + " of " + std::to_string(n));
+        auto tk = r.tokens();
+        const std::int64_t tag = r.next_int(tk, "element tag");
+        const std::int64_t type = r.next_int(tk, "element type");
+        const std::int64_t ntags = r.next_int(tk, "number of tags");
+        if (ntags < 0 || static_cast<std::size_t>(ntags) > tk.count())
+            r.fail("bad number of tags " + std::to_string(ntags) + " for element " +
+                   std::to_string(tag));
+        if (type != kTetType) {
+            ++d.skipped[type];
+            continue;
+        }
+        std::int64_t physical = 0;
+        for (std::int64_t k = 0; k < ntags; ++k) {
+            const std::int64_t value = r.next_int(tk, "element tag value");
+            if (k == 0) physical = value;
+        }
+        add_tet(r, d, tag, tk, region_from_tag(r, physical), 0, 0);
+    }
+    expect_line(r, "$EndElements", "after " + std::to_string(n) + " elements");
+}
+
+void read_entities_41(detail::TextReader& r, GmshData& d) {
+    r.require_line("the entity counts");
+    auto header = r.tokens();
+    std::int64_t counts[4];
+    for (auto& c : counts) c = r.next_int(header, "entity count");
+    r.expect_end(header, "the 4 entity counts");
+    for (auto& c : counts) c = r.check_count(c, 4, "entity");
+    for (std::int64_t i = 0; i < counts[0] + counts[1] + counts[2]; ++i)
+        r.require_line("a point, curve or surface entity");
+    for (std::int64_t i = 0; i < counts[3]; ++i) {
+        r.require_line("volume entity " + std::to_string(i + 1));
+        auto tk = r.tokens();
+        const std::int64_t tag = r.next_int(tk, "volume tag");
+        for (int k = 0; k < 6; ++k) r.next_double(tk, "bounding box coordinate");
+        const std::int64_t nphys = r.next_int(tk, "number of physical tags");
+        if (nphys < 0 || static_cast<std::size_t>(nphys) > tk.count())
+            r.fail("bad number of physical tags " + std::to_string(nphys));
+        if (nphys > 0) d.volume_physical[tag] = r.next_int(tk, "physical tag");
+    }
+    expect_line(r, "$EndEntities", "after the entities");
+}
+
+void read_nodes_41(detail::TextReader& r, GmshData& d) {
+    r.require_line("the node block header");
+    auto header = r.tokens();
+    const std::int64_t nblocks = r.next_int(header, "number of node blocks");
+    const std::int64_t nnodes = r.next_int(header, "number of nodes");
+    r.next_int(header, "minimum node tag");
+    r.next_int(header, "maximum node tag");
+    r.expect_end(header, "the node block header");
+    const index_t nb = r.check_count(nblocks, 4, "node block");
+    const index_t n = r.check_count(nnodes, 4, "node");
+    d.mesh.X.reserve(3 * static_cast<std::size_t>(n));
+    std::int64_t total = 0;
+    std::vector<std::pair<std::int64_t, std::int64_t>> tags;  // (tag, line) of one block
+    for (index_t b = 0; b < nb; ++b) {
+        r.require_line("node block " + std::to_string(b + 1) + " of " + std::to_string(nb));
+        auto tk = r.tokens();
+        r.next_int(tk, "entity dimension");
+        r.next_int(tk, "entity tag");
+        const std::int64_t parametric = r.next_int(tk, "parametric flag");
+        const std::int64_t count = r.next_int(tk, "number of nodes in the block");
+        r.expect_end(tk, "the node block header");
+        const index_t m = r.check_count(count, 4, "node");
+        total += m;
+        if (total > n)
+            r.fail("the node blocks hold more nodes than the header's count " +
+                   std::to_string(n));
+        tags.clear();
+        for (index_t i = 0; i < m; ++i) {
+            const std::int64_t tag = single_int(r, "node tag");
+            tags.emplace_back(tag, r.line_no());
+        }
+        for (index_t i = 0; i < m; ++i) {
+            r.require_line("the coordinates of node " + std::to_string(tags[i].first));
+            auto xyz = r.tokens();
+            add_node(r, d, tags[i].first, tags[i].second, xyz, parametric ? 3 : 0);
+        }
+    }
+    if (total != n)
+        r.fail("the node blocks hold " + std::to_string(total) + " nodes, the header says " +
+               std::to_string(n));
+    expect_line(r, "$EndNodes", "after " + std::to_string(n) + " nodes");
+}
+
+void read_elements_41(detail::TextReader& r, GmshData& d) {
+    r.require_line("the element block header");
+    auto header = r.tokens();
+    const std::int64_t nblocks = r.next_int(header, "number of element blocks");
+    const std::int64_t nelems = r.next_int(header, "number of elements");
+    r.next_int(header, "minimum element tag");
+    r.next_int(header, "maximum element tag");
+    r.expect_end(header, "the element block header");
+    const index_t nb = r.check_count(nblocks, 4, "element block");
+    const index_t n = r.check_count(nelems, 2, "element");
+    std::int64_t total = 0;
+    for (index_t b = 0; b < nb; ++b) {
+        r.require_line("element block " + std::to_string(b + 1) + " of " + std::to_string(nb));
+        auto tk = r.tokens();
+        const std::int64_t dim = r.next_int(tk, "entity dimension");
+        const std::int64_t entity = r.next_int(tk, "entity tag");
+        const std::int64_t type = r.next_int(tk, "element type");
+        const std::int64_t count = r.next_int(tk, "number of elements in the block");
+        r.expect_end(tk, "the element block header");
+        const index_t m = r.check_count(count, 2, "element");
+        total += m;
+        if (total > n)
+            r.fail("the element blocks hold more elements than the header's count " +
+                   std::to_string(n));
+        for (index_t i = 0; i < m; ++i) {
+            r.require_line("element " + std::to_string(i + 1) + " of block " +
+                           std::to_string(b + 1));
+            if (type != kTetType) continue;
+            auto et = r.tokens();
+            const std::int64_t tag = r.next_int(et, "element tag");
+            add_tet(r, d, tag, et, 0, static_cast<int>(dim), entity);
+        }
+        if (type != kTetType) d.skipped[type] += m;
+    }
+    if (total != n)
+        r.fail("the element blocks hold " + std::to_string(total) + " elements, the header says " +
+               std::to_string(n));
+    expect_line(r, "$EndElements", "after " + std::to_string(n) + " elements");
+}
+
+void skip_section(detail::TextReader& r, const std::string& name) {
+    const std::string end = "$End" + name;
+    const std::int64_t start = r.line_no();
+    while (r.next_line())
+        if (r.line() == end) return;
+    r.fail_at(start, "section $" + name + " has no " + end + " (file truncated?)");
+}
+
+// Maps node tags to vertex indices: a dense table when the tags are compact
+// (the usual case), else a sorted list searched by bisection.
+class TagMap {
+public:
+    TagMap(const detail::TextReader& r, const GmshData& d) {
+        const auto& ids = d.mesh.source.vertex_id;
+        sorted_.reserve(ids.size());
+        for (std::size_t i = 0; i < ids.size(); ++i)
+            sorted_.emplace_back(ids[i], static_cast<index_t>(i));
+        std::sort(sorted_.begin(), sorted_.end());
+        for (std::size_t i = 1; i < sorted_.size(); ++i)
+            if (sorted_[i].first == sorted_[i - 1].first) {
+                const index_t a = std::min(sorted_[i].second, sorted_[i - 1].second);
+                const index_t b = std::max(sorted_[i].second, sorted_[i - 1].second);
+                r.fail_at(d.node_tag_line[b],
+                          "duplicate node tag " + std::to_string(sorted_[i].first) +
+                              " (first defined at line " + std::to_string(d.node_tag_line[a]) +
+                              ")",
+                          b);
+            }
+        if (!sorted_.empty() &&
+            sorted_.back().first - sorted_.front().first < 4 * static_cast<std::int64_t>(ids.size()) + 1024) {
+            min_ = sorted_.front().first;
+            dense_.assign(static_cast<std::size_t>(sorted_.back().first - min_ + 1), -1);
+            for (const auto& [tag, v] : sorted_) dense_[tag - min_] = v;
+        }
+    }
+    index_t find(std::int64_t tag) const {
+        if (!dense_.empty())
+            return (tag >= min_ && tag - min_ < static_cast<std::int64_t>(dense_.size()))
+                       ? dense_[tag - min_]
+                       : -1;
+        const auto it = std::lower_bound(sorted_.begin(), sorted_.end(),
+                                         std::make_pair(tag, index_t{-1}));
+        return (it != sorted_.end() && it->first == tag) ? it->second : -1;
+    }
+
+private:
+    std::vector<std::pair<std::int64_t, index_t>> sorted_;
+    std::vector<index_t> dense_;
+    std::int64_t min_ = 0;
+};
+
+}  // namespace
+
+Mesh read_gmsh(const std::string& path, ReadReport* report) {
+    detail::TextReader r(path, '\0');
+    GmshData d;
+    r.require_line("'$MeshFormat'");
+    if (r.line() != "$MeshFormat")
+        r.fail("not a Gmsh MSH file: expected '$MeshFormat', got '" + detail::quote(r.line()) + "'");
+    r.require_line("the MSH version line");
+    {
+        auto tk = r.tokens();
+        const std::string_view version = r.need(tk, "MSH version");
+        const std::string_view file_type = r.need(tk, "MSH file type");
+        if (file_type == "1") r.fail("binary MSH is not supported; save the mesh as ASCII");
+        if (file_type != "0")
+            r.fail("bad MSH file type '" + detail::quote(file_type) + "' (0 = ASCII)");
+        if (version == "2" || version == "2.0" || version == "2.1" || version == "2.2")
+            d.version = 2;
+        else if (version == "4.1")
+            d.version = 41;
+        else
+            r.fail("unsupported MSH version '" + detail::quote(version) +
+                   "' (supported: 2.2 and 4.1 ASCII)");
+    }
+    expect_line(r, "$EndMeshFormat", "after the version line");
+
+    while (r.next_line()) {
+        const std::string_view line = r.line();
+        if (line.front() != '$')
+            r.fail("expected a section such as $Nodes, got '" + detail::quote(line) + "'");
+        const std::string name(line.substr(1));
+        if (name == "Nodes" || name == "Elements") {
+            bool& seen = name == "Nodes" ? d.have_nodes : d.have_elements;
+            if (seen) r.fail("a second $" + name + " section is not supported");
+            seen = true;
+            if (name == "Nodes")
+                d.version == 2 ? read_nodes_22(r, d) : read_nodes_41(r, d);
+            else
+                d.version == 2 ? read_elements_22(r, d) : read_elements_41(r, d);
+        } else if (name == "Entities" && d.version == 41) {
+            read_entities_41(r, d);
+        } else if (name.rfind("End", 0) == 0 || name == "MeshFormat" || name.empty()) {
+            r.fail("unexpected '" + detail::quote(line) + "'");
+        } else {
+            skip_section(r, name);
+        }
+    }
+    if (!d.have_nodes) r.fail("no $Nodes section");
+    if (!d.have_elements) r.fail("no $Elements section");
+
+    Mesh& mesh = d.mesh;
+    auto& src = mesh.source;
+    src.vertex_file = src.tet_file = path;
+    if (d.version == 41)
+        for (std::size_t t = 0; t < mesh.region.size(); ++t) {
+            const auto it = d.volume_physical.find(d.tet_entity[t]);
+            const std::int64_t tag = (d.tet_entity_dim[t] == 3 && it != d.volume_physical.end())
+                                         ? it->second
+                                         : d.tet_entity[t];
+            if (tag < std::numeric_limits<int>::min() || tag > std::numeric_limits<int>::max())
+                r.fail_at(src.tet_line[t], "region tag " + std::to_string(tag) + " does not fit an int");
+            mesh.region[t] = static_cast<int>(tag);
+        }
+
+    const TagMap map(r, d);
+    mesh.tets.resize(d.tet_nodes.size());
+    for (std::size_t i = 0; i < d.tet_nodes.size(); ++i) {
+        const index_t v = map.find(d.tet_nodes[i]);
+        if (v < 0) {
+            const std::size_t t = i / 4;
+            r.fail_at(src.tet_line[t],
+                      detail::item_label("tet", static_cast<std::int64_t>(t), src.tet_id[t]) +
+                          ": node tag " + std::to_string(d.tet_nodes[i]) +
+                          " is not defined in $Nodes",
+                      static_cast<std::int64_t>(t));
+        }
+        mesh.tets[i] = v;
+    }
+
+    if (report) {
+        for (const auto& [type, count] : d.skipped) {
+            report->skipped_elements += count;
+            if (!report->skipped_summary.empty()) report->skipped_summary += ", ";
+            report->skipped_summary += std::to_string(count) + " x " + element_type_name(type) +
+                                       " (type " + std::to_string(type) + ")";
+        }
+    }
+    return std::move(d.mesh);
+}
+
+}  // namespace edgefem

@@ -1,0 +1,146 @@
+// TetGen .node/.ele reader. Numbering starts at 0 or 1, as the first vertex
+// number in the .node file says (TetGen's own rule); the .ele file's vertex
+// indices use that base. Lines must hold exactly the values their header
+// declares, so a wrong header is caught instead of misread.
+#include <string>
+#include <vector>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "text_reader.hpp"
+
+namespace edgefem {
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// Checks an item number: the first sets the base (0 or 1), the others must
+// follow it consecutively; a repeated number is reported as a duplicate.
+std::int64_t check_number(const detail::TextReader& r, std::int64_t id, std::int64_t i,
+                          std::int64_t base, const std::vector<std::int64_t>& lines,
+                          const char* kind) {
+    if (i == 0) {
+        if (id != 0 && id != 1)
+            r.fail(std::string("the first ") + kind + " must be numbered 0 or 1, got " +
+                   std::to_string(id));
+        return id;
+    }
+    if (id == base + i) return base;
+    if (id >= base && id < base + i)
+        r.fail(std::string("duplicate ") + kind + " number " + std::to_string(id) +
+               " (first defined at line " + std::to_string(lines[id - base]) + ")");
+    r.fail(std::string(kind) + "s must be numbered consecutively: expected " +
+           std::to_string(base + i) + ", got " + std::to_string(id));
+}
+
+// Reads the .node file into mesh.X; returns the numbering base.
+std::int64_t read_node_file(const std::string& file, Mesh& mesh) {
+    detail::TextReader r(file, '#');
+    r.require_line("the header line 'N 3 #attributes #markers'");
+    auto header = r.tokens();
+    const std::int64_t n = r.next_int(header, "vertex count in the header");
+    const std::int64_t dim = header.empty() ? 3 : r.next_int(header, "dimension");
+    const std::int64_t nattr = header.empty() ? 0 : r.next_int(header, "attribute count");
+    const std::int64_t nmark = header.empty() ? 0 : r.next_int(header, "boundary marker flag");
+    r.expect_end(header, "the header 'N 3 #attributes #markers'");
+    if (dim != 3) r.fail("dimension must be 3, got " + std::to_string(dim));
+    if (nattr < 0 || nattr > 1000)
+        r.fail("bad attribute count " + std::to_string(nattr) + " in the header");
+    if (nmark != 0 && nmark != 1)
+        r.fail("boundary marker flag must be 0 or 1, got " + std::to_string(nmark));
+    const index_t nv = r.check_count(n, static_cast<int>(4 + nattr + nmark), "vertex");
+
+    mesh.X.resize(3 * static_cast<std::size_t>(nv));
+    auto& src = mesh.source;
+    src.vertex_file = file;
+    src.vertex_line.resize(nv);
+    src.vertex_id.resize(nv);
+    std::int64_t base = 0;
+    for (index_t v = 0; v < nv; ++v) {
+        r.require_line("vertex " + std::to_string(v + 1) + " of " + std::to_string(nv));
+        auto tk = r.tokens();
+        const std::int64_t id = r.next_int(tk, "vertex number");
+        base = check_number(r, id, v, base, src.vertex_line, "vertex");
+        src.vertex_line[v] = r.line_no();
+        src.vertex_id[v] = id;
+        double* p = &mesh.X[3 * static_cast<std::size_t>(v)];
+        p[0] = r.next_double(tk, "x coordinate");
+        p[1] = r.next_double(tk, "y coordinate");
+        p[2] = r.next_double(tk, "z coordinate");
+        for (std::int64_t a = 0; a < nattr; ++a) r.next_double(tk, "vertex attribute");
+        if (nmark) r.next_int(tk, "boundary marker");
+        r.expect_end(tk, "the values the header declares for vertex " + std::to_string(id));
+        detail::check_finite(r, p, v, id);
+    }
+    if (r.next_line())
+        r.fail("more vertex lines than the header's count " + std::to_string(nv));
+    return base;
+}
+
+void read_ele_file(const std::string& file, std::int64_t base, Mesh& mesh, ReadReport* report) {
+    detail::TextReader r(file, '#');
+    r.require_line("the header line 'T 4 #attributes'");
+    auto header = r.tokens();
+    const std::int64_t n = r.next_int(header, "tet count in the header");
+    const std::int64_t npt = header.empty() ? 4 : r.next_int(header, "nodes per tet");
+    const std::int64_t nattr = header.empty() ? 0 : r.next_int(header, "attribute count");
+    r.expect_end(header, "the header 'T 4 #attributes'");
+    if (npt != 4 && npt != 10)
+        r.fail("nodes per tet must be 4 or 10, got " + std::to_string(npt));
+    if (nattr < 0 || nattr > 1000)
+        r.fail("bad attribute count " + std::to_string(nattr) + " in the header");
+    const index_t nt = r.check_count(n, static_cast<int>(1 + npt + nattr), "tet");
+
+    auto& src = mesh.source;
+    src.tet_file = file;
+    src.tet_line.resize(nt);
+    src.tet_id.resize(nt);
+    std::vector<std::int64_t> raw(4 * static_cast<std::size_t>(nt));
+    if (nattr > 0) mesh.region.resize(nt);
+    std::int64_t tet_base = 0;
+    for (index_t t = 0; t < nt; ++t) {
+        r.require_line("tet " + std::to_string(t + 1) + " of " + std::to_string(nt));
+        auto tk = r.tokens();
+        const std::int64_t id = r.next_int(tk, "tet number");
+        tet_base = check_number(r, id, t, tet_base, src.tet_line, "tet");
+        src.tet_line[t] = r.line_no();
+        src.tet_id[t] = id;
+        for (std::int64_t k = 0; k < npt; ++k) {
+            const std::int64_t v = r.next_int(tk, "vertex index");
+            if (k < 4) raw[4 * static_cast<std::size_t>(t) + k] = v;
+            // Mid-edge nodes are range-checked here, as they are not kept.
+            if (k >= 4 && (v < base || v - base >= mesh.num_vertices()))
+                r.fail(detail::item_label("tet", t, id) + ": vertex index " + std::to_string(v) +
+                           " is out of range",
+                       t);
+        }
+        for (std::int64_t a = 0; a < nattr; ++a) {
+            const double value = r.next_double(tk, "tet attribute");
+            if (a == 0) mesh.region[t] = detail::region_from_attribute(r, value);
+        }
+        r.expect_end(tk, "the values the header declares for tet " + std::to_string(id));
+    }
+    if (r.next_line()) r.fail("more tet lines than the header's count " + std::to_string(nt));
+    mesh.tets = detail::resolve_tets(file, raw, base, mesh.num_vertices(), src.tet_line, src.tet_id);
+    if (npt == 10 && report)
+        report->warnings.push_back(
+            file + ": 10-node tets: kept the 4 corner nodes; the mid-edge nodes are left "
+                   "unreferenced (validate_mesh with compact_unreferenced removes them)");
+}
+
+}  // namespace
+
+Mesh read_tetgen(const std::string& path, ReadReport* report) {
+    std::string prefix = path;
+    if (ends_with(path, ".node")) prefix.resize(path.size() - 5);
+    else if (ends_with(path, ".ele")) prefix.resize(path.size() - 4);
+    Mesh mesh;
+    const std::int64_t base = read_node_file(prefix + ".node", mesh);
+    read_ele_file(prefix + ".ele", base, mesh, report);
+    return mesh;
+}
+
+}  // namespace edgefem

@@ -1,0 +1,374 @@
+// Mesh readers: the same small mesh in every format, the shared meshes in
+// TetGen and Gmsh form, malformed files, and a truncation / byte-flip fuzz.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/validate_mesh.hpp"
+#include "io_test_util.hpp"
+#include "test_meshes.hpp"
+
+using namespace edgefem;
+using edgefem::test::data_file;
+using edgefem::test::expect_mesh_error;
+
+namespace {
+
+// The mesh every file in tests/data/small* holds.
+const std::vector<double> kX = {0,   0,   0,   0.1, 0,    0,   0, 0.1, 0,
+                                0,   0,   0.1, 0.1, 0.1,  0.1, 0.05, 0.05, -0.1};
+const std::vector<index_t> kTets = {0, 1, 2, 3, 1, 2, 3, 4, 0, 2, 1, 5};
+const std::vector<int> kRegion = {1, 2, 1};
+
+void expect_small_mesh(const Mesh& m, bool with_region) {
+    EXPECT_EQ(m.X, kX);
+    EXPECT_EQ(m.tets, kTets);
+    if (with_region) EXPECT_EQ(m.region, kRegion);
+    else EXPECT_TRUE(m.region.empty());
+    EXPECT_EQ(m.source.vertex_line.size(), 6u);
+    EXPECT_EQ(m.source.vertex_id.size(), 6u);
+    EXPECT_EQ(m.source.tet_line.size(), 3u);
+    EXPECT_EQ(m.source.tet_id.size(), 3u);
+}
+
+std::string replace_once(std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << "test setup: '" << from << "' not found";
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+}
+
+}  // namespace
+
+TEST(read_mesh, AllFormatsGiveTheSameMesh) {
+    expect_small_mesh(read_tetgen(data_file("small0")), false);
+    expect_small_mesh(read_tetgen(data_file("small0.node")), false);
+    expect_small_mesh(read_tetgen(data_file("small1.ele")), true);
+    expect_small_mesh(read_gmsh(data_file("small22.msh")), true);
+    expect_small_mesh(read_gmsh(data_file("small41.msh")), true);
+    expect_small_mesh(read_medit(data_file("small.mesh")), true);
+    expect_small_mesh(read_vega(data_file("small.veg")), false);
+    // Dispatch by extension and by TetGen prefix.
+    expect_small_mesh(read_mesh(data_file("small0")), false);
+    expect_small_mesh(read_mesh(data_file("small1.node")), true);
+    expect_small_mesh(read_mesh(data_file("small22.msh")), true);
+    expect_small_mesh(read_mesh(data_file("small41.msh")), true);
+    expect_small_mesh(read_mesh(data_file("small.mesh")), true);
+    expect_small_mesh(read_mesh(data_file("small.veg")), false);
+    expect_small_mesh(read_mesh(data_file("small.veg"), MeshFormat::Vega), false);
+}
+
+TEST(read_mesh, TetGenSourceLinesAndIds) {
+    const Mesh m = read_tetgen(data_file("small1"));
+    EXPECT_EQ(m.source.vertex_file, data_file("small1.node"));
+    EXPECT_EQ(m.source.tet_file, data_file("small1.ele"));
+    EXPECT_EQ(m.source.vertex_line, (std::vector<std::int64_t>{4, 5, 8, 9, 10, 11}));
+    EXPECT_EQ(m.source.vertex_id, (std::vector<std::int64_t>{1, 2, 3, 4, 5, 6}));
+    EXPECT_EQ(m.source.tet_line, (std::vector<std::int64_t>{3, 4, 6}));
+    EXPECT_EQ(m.source.tet_id, (std::vector<std::int64_t>{1, 2, 3}));
+    const Mesh z = read_tetgen(data_file("small0"));
+    EXPECT_EQ(z.source.vertex_id, (std::vector<std::int64_t>{0, 1, 2, 3, 4, 5}));
+    EXPECT_EQ(z.source.tet_line, (std::vector<std::int64_t>{2, 3, 4}));
+    EXPECT_NE(m.describe_tet(2).find("small1.ele:6"), std::string::npos) << m.describe_tet(2);
+}
+
+TEST(read_mesh, GmshTagsLinesAndSkippedElements) {
+    ReadReport report;
+    const Mesh m = read_gmsh(data_file("small22.msh"), &report);
+    EXPECT_EQ(m.source.vertex_id, (std::vector<std::int64_t>{10, 20, 30, 40, 55, 7}));
+    EXPECT_EQ(m.source.vertex_line, (std::vector<std::int64_t>{11, 12, 13, 14, 15, 16}));
+    EXPECT_EQ(m.source.tet_id, (std::vector<std::int64_t>{4, 6, 7}));
+    EXPECT_EQ(m.source.tet_line, (std::vector<std::int64_t>{23, 25, 26}));
+    EXPECT_EQ(report.skipped_elements, 4);
+    EXPECT_EQ(report.skipped_summary, "1 x line (type 1), 2 x triangle (type 2), 1 x point (type 15)");
+
+    ReadReport report41;
+    const Mesh m41 = read_gmsh(data_file("small41.msh"), &report41);
+    EXPECT_EQ(report41.skipped_elements, 2);
+    EXPECT_EQ(report41.skipped_summary, "2 x triangle (type 2)");
+    EXPECT_EQ(m41.source.vertex_id, (std::vector<std::int64_t>{101, 102, 103, 104, 105, 106}));
+    EXPECT_EQ(m41.source.tet_id, (std::vector<std::int64_t>{2, 3, 4}));
+}
+
+TEST(read_mesh, Gmsh41RegionFallsBackToEntityTag) {
+    edgefem::test::TempDir dir("read41");
+    std::string text = edgefem::test::slurp(data_file("small41.msh"));
+    const auto a = text.find("$Entities"), b = text.find("$EndEntities\n");
+    text.erase(a, b + 13 - a);
+    edgefem::test::spit(dir.file("noent.msh"), text);
+    const Mesh m = read_gmsh(dir.file("noent.msh"));
+    EXPECT_EQ(m.region, (std::vector<int>{1, 2, 3}));
+    EXPECT_EQ(m.tets, kTets);
+}
+
+TEST(read_mesh, MeditSkipsOtherSections) {
+    ReadReport report;
+    const Mesh m = read_medit(data_file("small.mesh"), &report);
+    EXPECT_EQ(report.skipped_elements, 3);  // 1 edge + 2 triangles; corners are not elements
+    EXPECT_EQ(report.skipped_summary, "2 x Corners, 1 x Edges, 2 x triangles");
+    EXPECT_EQ(m.source.vertex_id[5], 6);
+    EXPECT_EQ(m.source.tet_line, (std::vector<std::int64_t>{27, 28, 29}));
+}
+
+TEST(read_mesh, TetGenTenNodeTetsKeepCorners) {
+    edgefem::test::TempDir dir("read10");
+    // small0 plus 6 extra (mid-edge) vertices; only the corners are kept.
+    std::string node = "12 3 0 0\n" + edgefem::test::slurp(data_file("small0.node")).substr(8);
+    for (int i = 6; i < 12; ++i) node += std::to_string(i) + " 1 1 " + std::to_string(i) + "\n";
+    edgefem::test::spit(dir.file("ten.node"), node);
+    edgefem::test::spit(dir.file("ten.ele"),
+                        "3 10 1\n"
+                        "0 0 1 2 3 6 7 8 9 10 11 1\n"
+                        "1 1 2 3 4 6 7 8 9 10 11 2\n"
+                        "2 0 2 1 5 6 7 8 9 10 11 1\n");
+    ReadReport report;
+    const Mesh m = read_tetgen(dir.file("ten"), &report);
+    EXPECT_EQ(m.tets, kTets);
+    EXPECT_EQ(m.region, kRegion);
+    EXPECT_EQ(m.num_vertices(), 12);
+    ASSERT_EQ(report.warnings.size(), 1u);
+    EXPECT_NE(report.warnings[0].find("10-node"), std::string::npos);
+}
+
+TEST(read_mesh_errors, MissingAndUnknownFiles) {
+    expect_mesh_error([] { read_tetgen(data_file("no_such_mesh")); },
+                      {"no_such_mesh.node", "cannot open"});
+    expect_mesh_error([] { read_gmsh(data_file("no_such_mesh.msh")); }, {"no_such_mesh.msh"});
+    expect_mesh_error([] { read_mesh(data_file("small.stl")); }, {"small.stl", "mesh format"});
+    expect_mesh_error([] { read_mesh(data_file("x.meshb")); }, {"binary MEDIT"});
+    expect_mesh_error([] { read_medit(test::test_data_dir()); }, {"directory"});
+}
+
+TEST(read_mesh_errors, HandWrittenBadFiles) {
+    const auto bad = [](const std::string& name) { return data_file("bad/" + name); };
+    expect_mesh_error([&] { read_tetgen(bad("truncated")); }, {"truncated.ele:1:", "truncated"});
+    expect_mesh_error([&] { read_tetgen(bad("bad_header")); },
+                      {"bad_header.node:1:", "'six'", "vertex count"});
+    expect_mesh_error([&] { read_gmsh(bad("bad_header.msh")); },
+                      {"bad_header.msh:2:", "unsupported MSH version '3.0'"});
+    expect_mesh_error([&] { read_tetgen(bad("out_of_range")); },
+                      {"out_of_range.ele:3:", "tet 1", "vertex index 6", "out of range", "0..5"});
+    expect_mesh_error([&] { read_tetgen(bad("nan")); },
+                      {"nan.node:4:", "vertex 2", "non-finite", "nan"});
+    expect_mesh_error([&] { read_tetgen(bad("negative_count")); },
+                      {"negative_count.node:1:", "negative vertex count -6"});
+    expect_mesh_error([&] { read_tetgen(bad("huge_count")); },
+                      {"huge_count.ele:1:", "999999999999", "exceeds"});
+    expect_mesh_error([&] { read_gmsh(bad("huge_count.msh")); },
+                      {"huge_count.msh:5:", "2000000000", "more than the rest of the file"});
+    expect_mesh_error([&] { read_gmsh(bad("binary.msh")); },
+                      {"binary.msh:2:", "binary MSH is not supported"});
+    expect_mesh_error([&] { read_mesh(bad("garbage.msh")); }, {"garbage.msh:1:", "not a Gmsh"});
+    expect_mesh_error([&] { read_medit(bad("empty.mesh")); }, {"empty.mesh", "file is empty"});
+    expect_mesh_error([&] { read_tetgen(bad("empty")); }, {"empty.node", "file is empty"});
+    expect_mesh_error([&] { read_gmsh(bad("duplicate_node.msh")); },
+                      {"duplicate_node.msh:9:", "duplicate node tag 2", "line 7"});
+    expect_mesh_error([&] { read_tetgen(bad("duplicate_id")); },
+                      {"duplicate_id.node:4:", "duplicate vertex number 1", "line 3"});
+    expect_mesh_error([&] { read_vega(bad("cubic.veg")); },
+                      {"cubic.veg:8:", "CUBIC", "not supported"});
+    expect_mesh_error([&] { read_vega(bad("include.veg")); },
+                      {"include.veg:1:", "*INCLUDE is not supported"});
+}
+
+// Variants of the good files, each broken in one way.
+TEST(read_mesh_errors, EditedVariants) {
+    edgefem::test::TempDir dir("readbad");
+    const std::string msh = edgefem::test::slurp(data_file("small22.msh"));
+    const std::string msh41 = edgefem::test::slurp(data_file("small41.msh"));
+    const std::string medit = edgefem::test::slurp(data_file("small.mesh"));
+    const std::string veg = edgefem::test::slurp(data_file("small.veg"));
+    const std::string node = edgefem::test::slurp(data_file("small0.node"));
+    const std::string ele = edgefem::test::slurp(data_file("small0.ele"));
+    const auto write = [&](const std::string& name, const std::string& text) {
+        edgefem::test::spit(dir.file(name), text);
+        return dir.file(name);
+    };
+    const auto tetgen = [&](const std::string& name, const std::string& n, const std::string& e) {
+        write(name + ".node", n);
+        write(name + ".ele", e);
+        return dir.file(name);
+    };
+
+    // Gmsh
+    auto p = write("undef.msh", replace_once(msh, "7 4 2 1 100 10 30 20 7", "7 4 2 1 100 10 30 20 99"));
+    expect_mesh_error([&] { read_gmsh(p); },
+                      {"undef.msh:26:", "tet 2 (numbered 7 in the file)", "node tag 99"});
+    p = write("word.msh", replace_once(msh, "40 0 0 0.1", "40 0 zero 0.1"));
+    expect_mesh_error([&] { read_gmsh(p); }, {"word.msh:14:", "'zero'", "y coordinate"});
+    p = write("inf.msh", replace_once(msh, "40 0 0 0.1", "40 0 0 -inf"));
+    expect_mesh_error([&] { read_gmsh(p); }, {"inf.msh:14:", "vertex 3 (numbered 40 in the file)", "non-finite", "inf"});
+    p = write("short.msh", msh.substr(0, msh.find("30 0 0.1 0")));
+    expect_mesh_error([&] { read_gmsh(p); }, {"short.msh:10:", "truncated"});
+    p = write("count.msh", replace_once(msh, "$Elements\n7\n", "$Elements\n6\n"));
+    expect_mesh_error([&] { read_gmsh(p); }, {"count.msh:26:", "$EndElements"});
+    p = write("noend.msh", replace_once(msh, "$EndComments\n", ""));
+    expect_mesh_error([&] { read_gmsh(p); }, {"noend.msh:28:", "$EndComments", "truncated"});
+    p = write("tags.msh", replace_once(msh, "4 4 2 1 100 10 20 30 40", "4 4 9 1 100 10 20 30 40"));
+    expect_mesh_error([&] { read_gmsh(p); }, {"tags.msh:23:", "number of tags 9"});
+    p = write("v40.msh", replace_once(msh, "2.2 0 8", "4.0 0 8"));
+    expect_mesh_error([&] { read_gmsh(p); }, {"v40.msh:2:", "unsupported MSH version '4.0'"});
+    p = write("blocks.msh", replace_once(msh41, "3 2 0 2\n", "3 2 0 3\n"));
+    expect_mesh_error([&] { read_gmsh(p); }, {"blocks.msh:", "more nodes than the header"});
+    p = write("neg41.msh", replace_once(msh41, "3 1 4 1\n", "3 1 4 -1\n"));
+    expect_mesh_error([&] { read_gmsh(p); }, {"neg41.msh:", "negative element count -1"});
+
+    // MEDIT
+    p = write("range.mesh", replace_once(medit, "2 3 4 5 2", "2 3 4 7 2"));
+    expect_mesh_error([&] { read_medit(p); },
+                      {"range.mesh:28:", "tet 1 (numbered 2 in the file)", "vertex index 7", "1..6"});
+    p = write("dim.mesh", replace_once(medit, "Dimension\n3", "Dimension\n2"));
+    expect_mesh_error([&] { read_medit(p); }, {"dim.mesh:4:", "dimension 2"});
+    p = write("neg.mesh", replace_once(medit, "Vertices\n6", "Vertices\n-6"));
+    expect_mesh_error([&] { read_medit(p); }, {"neg.mesh:7:", "negative vertex count"});
+    p = write("notmedit.mesh", "Hello world\n");
+    expect_mesh_error([&] { read_medit(p); }, {"notmedit.mesh:1:", "MeshVersionFormatted"});
+    p = write("trunc.mesh", medit.substr(0, medit.find("TETRAHEDRA") + 13));
+    expect_mesh_error([&] { read_medit(p); }, {"trunc.mesh:", "truncated"});
+
+    // Vega
+    p = write("range.veg", replace_once(veg, "2 2 3 4 5", "2 2 3 4 0"));
+    expect_mesh_error([&] { read_vega(p); }, {"range.veg:16:", "tet 1 (numbered 2 in the file)", "vertex index 0"});
+    p = write("nan.veg", replace_once(veg, "5 0.1 0.1 0.1", "5 0.1 NaN 0.1"));
+    expect_mesh_error([&] { read_vega(p); }, {"nan.veg:8:", "vertex 4 (numbered 5 in the file)", "non-finite"});
+    p = write("extra.veg", replace_once(veg, "6 0.05 0.05 -0.1\n", "6 0.05 0.05 -0.1\n7 1 1 1\n"));
+    expect_mesh_error([&] { read_vega(p); }, {"extra.veg:10:", "more lines than the section's count"});
+    p = write("count.veg", replace_once(veg, "3 4 0\n", "3 8 0\n"));
+    expect_mesh_error([&] { read_vega(p); }, {"count.veg:14:", "nodes per element must be 4"});
+
+    // TetGen
+    p = tetgen("extra", node + "6 1 1 1\n", ele);
+    expect_mesh_error([&] { read_tetgen(p); }, {"extra.node:8:", "more vertex lines"});
+    p = tetgen("gap", replace_once(node, "3 0 0 0.1", "4 0 0 0.1"), ele);
+    expect_mesh_error([&] { read_tetgen(p); }, {"gap.node:5:", "consecutively", "expected 3, got 4"});
+    p = tetgen("missing", replace_once(node, "3 0 0 0.1", "3 0 0"), ele);
+    expect_mesh_error([&] { read_tetgen(p); }, {"missing.node:5:", "missing z coordinate"});
+    p = tetgen("attr", node, "3 4 1\n0 0 1 2 3   # no attribute here\n1 1 2 3 4 2\n2 0 2 1 5 1\n");
+    expect_mesh_error([&] { read_tetgen(p); }, {"attr.ele:2:", "missing tet attribute"});
+    p = tetgen("dim", replace_once(node, "6 3 0 0", "6 2 0 0"), ele);
+    expect_mesh_error([&] { read_tetgen(p); }, {"dim.node:1:", "dimension must be 3"});
+    p = tetgen("npt", node, replace_once(ele, "3 4 0", "3 6 0"));
+    expect_mesh_error([&] { read_tetgen(p); }, {"npt.ele:1:", "nodes per tet must be 4 or 10"});
+    p = tetgen("int", node, replace_once(ele, "1 1 2 3 4", "1 1 2 3.5 4"));
+    expect_mesh_error([&] { read_tetgen(p); }, {"int.ele:3:", "expected an integer", "'3.5'"});
+    p = tetgen("big", node, replace_once(ele, "1 1 2 3 4", "1 1 2 99999999999999999999 4"));
+    expect_mesh_error([&] { read_tetgen(p); }, {"big.ele:3:", "out of the 64-bit integer range"});
+    p = tetgen("base", replace_once(node, "0 0 0 0\n1 0.1", "7 0 0 0\n1 0.1"), ele);
+    expect_mesh_error([&] { read_tetgen(p); }, {"base.node:2:", "numbered 0 or 1, got 7"});
+    // 1-based .node with 0-based indices in the .ele: index 0 is out of range.
+    std::string node1 = "6 3 0 0\n";
+    for (int i = 0; i < 6; ++i)
+        node1 += std::to_string(i + 1) + " " + std::to_string(kX[3 * i]) + " " +
+                 std::to_string(kX[3 * i + 1]) + " " + std::to_string(kX[3 * i + 2]) + "\n";
+    p = tetgen("base1", node1, ele);
+    expect_mesh_error([&] { read_tetgen(p); }, {"base1.ele:2:", "tet 0", "vertex index 0", "1..6"});
+}
+
+TEST(read_mesh, SharedMeshesTetGenAndGmshAgree) {
+    int found = 0;
+    for (const char* name : {"box-1200", "spot-2k", "bunny-4k", "armadillo-7k"}) {
+        const std::string prefix = test::shared_mesh_prefix(name);
+        if (prefix.empty()) continue;
+        ++found;
+        SCOPED_TRACE(name);
+        const Mesh a = read_tetgen(prefix);
+        ReadReport report;
+        const Mesh b = read_gmsh(prefix + ".msh", &report);
+        EXPECT_EQ(a.X, b.X);
+        EXPECT_EQ(a.tets, b.tets);
+        EXPECT_EQ(report.skipped_elements, 0);
+        EXPECT_TRUE(a.region.empty());
+        EXPECT_EQ(b.region, std::vector<int>(b.num_tets(), 1));
+        const auto& table = test::shared_mesh_table();
+        const auto info = std::find_if(table.begin(), table.end(),
+                                       [&](const auto& i) { return std::string(i.name) == name; });
+        ASSERT_NE(info, table.end());
+        EXPECT_EQ(a.num_vertices(), info->vertices);
+        EXPECT_EQ(a.num_tets(), info->tets);
+        Mesh c = a;
+        const ValidationReport v = validate_mesh(c);
+        EXPECT_EQ(v.unreferenced_vertices, 0);
+        EXPECT_EQ(v.flipped_tets, 0);
+    }
+    if (found == 0)
+        GTEST_SKIP() << "shared meshes not found under " << test::shared_mesh_dir();
+}
+
+TEST(read_mesh, SharedMeshCountsMatchTable) {
+    int found = 0;
+    for (const auto& info : test::shared_mesh_table()) {
+        if (info.tets > 300000) continue;  // the 1M mesh is read in test_validate_mesh
+        const std::string prefix = test::shared_mesh_prefix(info.name);
+        if (prefix.empty()) continue;
+        ++found;
+        const Mesh m = read_mesh(prefix + ".node");
+        EXPECT_EQ(m.num_vertices(), info.vertices) << info.name;
+        EXPECT_EQ(m.num_tets(), info.tets) << info.name;
+    }
+    if (found == 0)
+        GTEST_SKIP() << "shared meshes not found under " << test::shared_mesh_dir();
+}
+
+// Every truncation and many random byte edits of the good files must either
+// read or throw edgefem::Error: never crash, hang or throw anything else.
+TEST(read_mesh_fuzz, TruncationsAndByteFlips) {
+    edgefem::test::TempDir dir("fuzz");
+    struct Case {
+        std::string name;   // file to damage (written into dir)
+        std::string other;  // TetGen partner file copied intact, or ""
+        Mesh (*read)(const std::string&, ReadReport*);
+    };
+    const std::vector<Case> cases = {
+        {"small22.msh", "", read_gmsh},       {"small41.msh", "", read_gmsh},
+        {"small.mesh", "", read_medit},       {"small.veg", "", read_vega},
+        {"small1.node", "small1.ele", read_tetgen}, {"small1.ele", "small1.node", read_tetgen},
+    };
+    std::mt19937 rng(20240611);
+    static const char kAlphabet[] = "0123456789-+.eE \n\t#$*naifNAI\r\0\xff";
+    const std::string alphabet(kAlphabet, sizeof kAlphabet - 1);
+    int reads = 0, errors = 0;
+    const auto attempt = [&](const Case& c, const std::string& text) {
+        // Unlink first: rewriting in place makes ext4 flush on every close.
+        std::filesystem::remove(dir.file(c.name));
+        edgefem::test::spit(dir.file(c.name), text);
+        try {
+            ReadReport report;
+            Mesh m = c.read(dir.file(c.name), &report);
+            ++reads;
+            try {
+                validate_mesh(m, {});
+            } catch (const edgefem::Error&) {
+            }
+        } catch (const edgefem::Error&) {
+            ++errors;
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << c.name << ": non-edgefem exception " << e.what() << " for input:\n"
+                          << text;
+        }
+    };
+    for (const Case& c : cases) {
+        const std::string good = edgefem::test::slurp(data_file(c.name));
+        ASSERT_FALSE(good.empty()) << c.name;
+        if (!c.other.empty())
+            edgefem::test::spit(dir.file(c.other), edgefem::test::slurp(data_file(c.other)));
+        for (std::size_t n = 0; n <= good.size(); ++n) attempt(c, good.substr(0, n));
+        for (int trial = 0; trial < 1500; ++trial) {
+            std::string text = good;
+            const int flips = 1 + static_cast<int>(rng() % 3);
+            for (int f = 0; f < flips; ++f) {
+                const std::size_t at = rng() % text.size();
+                text[at] = (rng() % 2) ? alphabet[rng() % alphabet.size()]
+                                       : static_cast<char>(rng() % 256);
+            }
+            attempt(c, text);
+        }
+    }
+    EXPECT_GT(reads, 0);
+    EXPECT_GT(errors, 0);
+}
