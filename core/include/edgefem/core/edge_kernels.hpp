@@ -86,14 +86,18 @@ inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, 
 }
 
 // Edge term of the stiffness: K(E) = -g I - 2 L(E) p~ p~^T (overwrites).
-template <class S>
+// `Definite` uses max(g, 0) instead of g: the Hessian is J^T A J (positive
+// semi-definite) plus the edge Laplacian weighted by g, so only edges with
+// g < 0 can make K indefinite (formulation.md section 5; forces unchanged).
+template <bool Definite = false, class S>
 inline void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict p, const double* __restrict g,
                            S* __restrict K) {
     const S* q = &p[3 * std::size_t(e)];
     S* k = &K[9 * std::size_t(e)];
     const S c = -2 * m.LE[e];
+    const S ge = Definite ? S(std::max(g[e], 0.0)) : S(g[e]);
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) k[3 * i + j] = c * q[i] * q[j] - (i == j ? S(g[e]) : S(0));
+        for (int j = 0; j < 3; ++j) k[3 * i + j] = c * q[i] * q[j] - (i == j ? ge : S(0));
 }
 
 // TSEP term for the segment of first edge e0: Kp = 2 L(P) p~(E0) p~(E1)^T
@@ -172,12 +176,13 @@ double edge_forces(const EdgeModel<S>& m, const S* u, S* f, EdgeState<S>& st) {
     return 0.25 * W;
 }
 
-// Per-edge tangent stiffness from the state of the last edge_forces call.
-template <ModelKind Kind, class S>
+// Per-edge tangent stiffness from the state of the last edge_forces call
+// (`Definite`: see kernel::edge_stiffness).
+template <ModelKind Kind, bool Definite = false, class S>
 void edge_stiffness_all(const EdgeModel<S>& m, const EdgeState<S>& st, EdgeStiffness<S>& K) {
     const index_t ne = m.num_edges();
     if (K.K.size() != 9 * (std::size_t(ne) + 1)) K.resize(ne);
-    for (index_t e = 0; e < ne; ++e) kernel::edge_stiffness(m, e, st.p.data(), st.g.data(), K.K.data());
+    for (index_t e = 0; e < ne; ++e) kernel::edge_stiffness<Definite>(m, e, st.p.data(), st.g.data(), K.K.data());
     if constexpr (Kind == ModelKind::FE)
         for (index_t e = 0; e < ne; ++e) kernel::tsep_stiffness_segment(m, e, st.p.data(), K.K.data());
 }

@@ -1,0 +1,48 @@
+// One interface over the elastic models a simulation can use — edge-based FE,
+// edge-based SN, or the per-tet method — so the integrators never know which
+// runs. Each virtual call is a whole-mesh kernel; the FE/SN and
+// definite/plain choices are template parameters inside.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/material.hpp"
+#include "edgefem/core/mesh.hpp"
+
+namespace edgefem {
+
+enum class Method { Edge, Tet };
+
+template <class S>
+class ElasticOperator {
+public:
+    virtual ~ElasticOperator() = default;
+    virtual index_t num_vertices() const = 0;
+    // f = dW/du at displacement u (3 #V, overwritten). Returns W when
+    // `energy`, else 0. Remembers u for build_stiffness.
+    virtual double forces(const S* u, S* f, bool energy) = 0;
+    // W at u, without forces.
+    virtual double energy(const S* u) = 0;
+    // K at the configuration of the last forces() call. `definite` clamps
+    // g(E) at zero inside K (edge method only): K becomes positive
+    // semi-definite, the forces are unchanged.
+    virtual void build_stiffness(bool definite) = 0;
+    // y = K x with the K of the last build_stiffness (3 #V, overwritten).
+    virtual void multiply(const S* x, S* y) const = 0;
+    // The 3x3 diagonal blocks of K (9 #V, row-major, overwritten).
+    virtual void diagonal_blocks(S* D) const = 0;
+    // Every nonzero 3x3 block of K: (row vertex, column vertex, block), the
+    // diagonal blocks included, each (i, j) pair once per contribution.
+    virtual void for_each_block(void (*visit)(void*, index_t, index_t, const S*), void* ctx) const = 0;
+    // Number of tets with non-positive volume at the last forces() call.
+    virtual index_t inverted_tets(const S* u) const = 0;
+};
+
+// Throws InvalidArgument for SN with the per-tet method.
+template <class S>
+std::unique_ptr<ElasticOperator<S>> make_elastic_operator(const Mesh& mesh, const Materials& materials,
+                                                          ModelKind model, Method method);
+
+}  // namespace edgefem

@@ -1,0 +1,71 @@
+// A simulation scene: what is simulated (mesh, materials, model), what acts
+// on it (gravity, damping, fixed and prescribed vertices) and how it is
+// stepped (integrator, time step, solver settings). Plain data; validate()
+// checks it and names the offending field.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/elastic_operator.hpp"
+#include "edgefem/core/material.hpp"
+#include "edgefem/core/mesh.hpp"
+
+namespace edgefem {
+
+enum class Integrator {
+    Explicit,      // symplectic Euler: never builds K
+    SemiImplicit,  // linearised backward Euler, one K per step, CG (the talk's form)
+    Implicit,      // backward Euler solved by Newton with line search (the accuracy reference)
+};
+
+enum class LinearSolver {
+    CG,      // matrix-free CG on the per-edge K, block-Jacobi preconditioned
+    Direct,  // assembled sparse K, Eigen's SimplicialLDLT
+};
+
+struct SolverSettings {
+    LinearSolver linear_solver = LinearSolver::CG;
+    double cg_tolerance = 1e-6;   // relative residual |r| / |b| of the projected system
+    int cg_max_iterations = 500;
+    int cg_fixed_iterations = 0;  // > 0: exactly this many warm-started iterations (haptic budget)
+    bool definite_stiffness = false;  // clamp g(E) at zero inside K (edge method)
+    double newton_tolerance = 1e-10;  // relative residual for Implicit and static solves
+    int newton_max_iterations = 50;
+    int load_steps = 1;               // static: initial number of load steps (halved on failure)
+    int max_step_halvings = 0;        // dynamics: retry a failed step with dt/2 up to this often
+};
+
+// A vertex driven to a target position.
+struct Prescribed {
+    index_t vertex;
+    std::array<double, 3> target;
+};
+
+struct Scene {
+    Mesh mesh;
+    Materials materials;
+    ModelKind model = ModelKind::FE;
+    Method method = Method::Edge;
+    std::array<double, 3> gravity{0, 0, 0};  // m/s^2
+    double rayleigh_alpha = 0;               // D = alpha M + beta K
+    double rayleigh_beta = 0;
+    std::vector<index_t> fixed;              // held at their rest position
+    std::vector<Prescribed> prescribed;      // moved linearly from rest to target
+    int prescribed_steps = 1;                // dynamics: steps over which targets are reached
+    Integrator integrator = Integrator::SemiImplicit;
+    double dt = 1e-3;                        // s
+    int steps = 1000;
+    SolverSettings solver;
+    bool count_inverted_tets = true;         // per-step statistic (one pass over the tets)
+
+    // Throws InvalidArgument naming the field (e.g. "dt", "fixed[3]").
+    void validate() const;
+};
+
+const char* to_string(Integrator i);
+const char* to_string(LinearSolver s);
+
+}  // namespace edgefem

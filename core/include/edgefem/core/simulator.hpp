@@ -1,0 +1,101 @@
+// The simulator an application links and steps: it owns the scene and the
+// state (displacement u = x - X and velocity, in the user's vertex numbering)
+// and advances it with the scene's integrator.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/scene.hpp"
+
+namespace edgefem {
+
+// A step or solve that could not produce a finite, converged state. The
+// message names the step and, for non-finite state, the vertex.
+class SimulationError : public Error {
+public:
+    SimulationError(const std::string& message, long step, index_t vertex = -1)
+        : Error(message), step_(step), vertex_(vertex) {}
+    long step() const { return step_; }
+    index_t vertex() const { return vertex_; }
+
+private:
+    long step_;
+    index_t vertex_;
+};
+
+struct StepStats {
+    double force_ms = 0;      // internal forces (and energy where needed)
+    double stiffness_ms = 0;  // building K (and its preconditioner / assembly)
+    double solve_ms = 0;      // linear solves
+    int solver_iterations = 0;  // CG iterations (summed over Newton iterations)
+    int newton_iterations = 0;  // Implicit / static
+    double residual = 0;        // final relative residual of the last solve
+    bool negative_curvature = false;  // CG met p^T A p <= 0 (K indefinite)
+    index_t inverted_tets = 0;  // at the end of the step
+    int halvings = 0;           // step halvings used
+};
+
+struct Energies {
+    double kinetic = 0, elastic = 0, gravity = 0;  // gravity: -m g.x summed (potential)
+    double total() const { return kinetic + elastic + gravity; }
+};
+
+struct StaticResult {
+    int newton_iterations = 0;
+    int load_steps = 0;      // load steps finally used
+    double residual = 0;     // |R| / |external load + reactions scale|
+    bool converged = false;
+};
+
+template <class S>
+class Simulator {
+public:
+    // Validates the scene (InvalidArgument naming the field) and sets up the
+    // model; the state starts at rest (u = 0, v = 0).
+    explicit Simulator(Scene scene);
+    ~Simulator();
+    Simulator(Simulator&&) noexcept;
+    Simulator& operator=(Simulator&&) noexcept;
+
+    const Scene& scene() const;
+    index_t num_vertices() const;
+
+    // Advances by scene().dt with the scene's integrator; throws
+    // SimulationError on non-finite state or a failed solve (after the
+    // allowed step halvings).
+    const StepStats& step();
+    // Static equilibrium under gravity, external forces and the prescribed
+    // targets (reached fully), by Newton with line search and automatic load
+    // stepping; the result becomes the state (velocity zero).
+    StaticResult solve_static();
+
+    // Zero-copy views (3 #V, xyz per vertex). External forces are the
+    // application's to change between steps (e.g. a haptic probe); forces()
+    // holds the internal elastic forces of the last evaluation.
+    std::span<S> displacement();
+    std::span<S> velocity();
+    std::span<S> external_forces();
+    std::span<const S> forces() const;
+    std::span<const double> lumped_mass() const;  // #V
+    // Current positions X + u (computed, 3 #V).
+    std::vector<double> positions() const;
+
+    // Energies of the current state (computes the elastic energy).
+    Energies energies();
+    long step_index() const;
+    double time() const;
+    const StepStats& last_stats() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+extern template class Simulator<double>;
+extern template class Simulator<float>;
+
+}  // namespace edgefem

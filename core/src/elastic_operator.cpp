@@ -1,0 +1,126 @@
+#include "edgefem/core/elastic_operator.hpp"
+
+#include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/inverted_tets.hpp"
+#include "edgefem/core/tet_kernels.hpp"
+
+namespace edgefem {
+
+namespace {
+
+template <class S, ModelKind Kind>
+class EdgeOperator final : public ElasticOperator<S> {
+public:
+    EdgeOperator(const Mesh& mesh, const Materials& materials) : mesh_(mesh) {
+        const Topology topo = build_topology(mesh);
+        model_ = make_edge_model<S>(topo, compute_coefficients(mesh, topo, materials));
+        state_.resize(model_.num_edges());
+        K_.resize(model_.num_edges());
+        scratch_.resize(3 * std::size_t(model_.num_vertices));
+    }
+    index_t num_vertices() const override { return model_.num_vertices; }
+    double forces(const S* u, S* f, bool energy) override {
+        return energy ? edge_forces<Kind, true>(model_, u, f, state_) : edge_forces<Kind, false>(model_, u, f, state_);
+    }
+    double energy(const S* u) override { return edge_forces<Kind, true>(model_, u, scratch_.data(), state_); }
+    void build_stiffness(bool definite) override {
+        if (definite)
+            edge_stiffness_all<Kind, true>(model_, state_, K_);
+        else
+            edge_stiffness_all<Kind, false>(model_, state_, K_);
+    }
+    void multiply(const S* x, S* y) const override { edge_multiply(model_, K_, x, y); }
+    void diagonal_blocks(S* D) const override { edge_diagonal_blocks(model_, K_, D); }
+    void for_each_block(void (*visit)(void*, index_t, index_t, const S*), void* ctx) const override {
+        S T[9];
+        for (index_t e = 0; e < model_.num_edges(); ++e) {
+            const S* k = &K_.K[9 * std::size_t(e)];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) T[3 * i + j] = k[3 * j + i];
+            visit(ctx, model_.edge[e][0], model_.edge[e][1], k);
+            visit(ctx, model_.edge[e][1], model_.edge[e][0], T);
+        }
+        std::vector<S> D(9 * std::size_t(model_.num_vertices));
+        diagonal_blocks(D.data());
+        for (index_t v = 0; v < model_.num_vertices; ++v) visit(ctx, v, v, &D[9 * std::size_t(v)]);
+    }
+    index_t inverted_tets(const S* u) const override { return count_inverted_tets(mesh_, u); }
+
+private:
+    const Mesh& mesh_;
+    EdgeModel<S> model_;
+    EdgeState<S> state_;
+    EdgeStiffness<S> K_;
+    std::vector<S> scratch_;
+};
+
+template <class S>
+class TetOperator final : public ElasticOperator<S> {
+public:
+    TetOperator(const Mesh& mesh, const Materials& materials)
+        : mesh_(mesh), model_(make_tet_model<S>(mesh, materials)), u_(mesh.X.size()), scratch_(mesh.X.size()) {}
+    index_t num_vertices() const override { return model_.num_vertices; }
+    double forces(const S* u, S* f, bool energy) override {
+        std::copy(u, u + u_.size(), u_.begin());
+        return energy ? tet_forces<true>(model_, u, f) : tet_forces<false>(model_, u, f);
+    }
+    double energy(const S* u) override { return tet_forces<true>(model_, u, scratch_.data()); }
+    void build_stiffness(bool definite) override {
+        if (definite)
+            throw InvalidArgument("the definite tangent (clamped g) exists only for the edge method");
+        tet_stiffness_all(model_, u_.data(), K_);
+    }
+    void multiply(const S* x, S* y) const override { tet_multiply(model_, K_, x, y); }
+    void diagonal_blocks(S* D) const override {
+        std::fill(D, D + 9 * std::size_t(model_.num_vertices), S(0));
+        for (index_t t = 0; t < model_.num_tets(); ++t)
+            for (int a = 0; a < 4; ++a) {
+                const S* blk = &K_.K[90 * std::size_t(t) + 9 * tet_block_index(a, a)];
+                S* d = &D[9 * std::size_t(model_.tet[t][a])];
+                for (int i = 0; i < 9; ++i) d[i] += blk[i];
+            }
+    }
+    void for_each_block(void (*visit)(void*, index_t, index_t, const S*), void* ctx) const override {
+        S T[9];
+        for (index_t t = 0; t < model_.num_tets(); ++t)
+            for (int a = 0; a < 4; ++a)
+                for (int b = a; b < 4; ++b) {
+                    const S* blk = &K_.K[90 * std::size_t(t) + 9 * tet_block_index(a, b)];
+                    visit(ctx, model_.tet[t][a], model_.tet[t][b], blk);
+                    if (a == b) continue;
+                    for (int i = 0; i < 3; ++i)
+                        for (int j = 0; j < 3; ++j) T[3 * i + j] = blk[3 * j + i];
+                    visit(ctx, model_.tet[t][b], model_.tet[t][a], T);
+                }
+    }
+    index_t inverted_tets(const S* u) const override { return count_inverted_tets(mesh_, u); }
+
+private:
+    const Mesh& mesh_;
+    TetModel<S> model_;
+    TetStiffness<S> K_;
+    std::vector<S> u_, scratch_;
+};
+
+}  // namespace
+
+template <class S>
+std::unique_ptr<ElasticOperator<S>> make_elastic_operator(const Mesh& mesh, const Materials& materials,
+                                                          ModelKind model, Method method) {
+    if (method == Method::Tet) {
+        if (model == ModelKind::SN)
+            throw InvalidArgument("the spring-network model exists only for the edge method");
+        return std::make_unique<TetOperator<S>>(mesh, materials);
+    }
+    if (model == ModelKind::SN) return std::make_unique<EdgeOperator<S, ModelKind::SN>>(mesh, materials);
+    return std::make_unique<EdgeOperator<S, ModelKind::FE>>(mesh, materials);
+}
+
+template std::unique_ptr<ElasticOperator<double>> make_elastic_operator<double>(const Mesh&, const Materials&, ModelKind,
+                                                                               Method);
+template std::unique_ptr<ElasticOperator<float>> make_elastic_operator<float>(const Mesh&, const Materials&, ModelKind,
+                                                                             Method);
+
+}  // namespace edgefem

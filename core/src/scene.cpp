@@ -1,0 +1,76 @@
+#include "edgefem/core/scene.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "edgefem/core/error.hpp"
+
+namespace edgefem {
+
+namespace {
+[[noreturn]] void bad(const std::string& field, const std::string& what) {
+    throw InvalidArgument("scene: \"" + field + "\": " + what);
+}
+void positive(const std::string& field, double v) {
+    if (!std::isfinite(v) || v <= 0) bad(field, "expected a positive finite number, got " + std::to_string(v));
+}
+void non_negative(const std::string& field, double v) {
+    if (!std::isfinite(v) || v < 0) bad(field, "expected a non-negative finite number, got " + std::to_string(v));
+}
+}  // namespace
+
+const char* to_string(Integrator i) {
+    switch (i) {
+        case Integrator::Explicit: return "explicit";
+        case Integrator::SemiImplicit: return "semi-implicit";
+        default: return "implicit";
+    }
+}
+
+const char* to_string(LinearSolver s) { return s == LinearSolver::CG ? "cg" : "direct"; }
+
+void Scene::validate() const {
+    const index_t nv = mesh.num_vertices();
+    if (mesh.num_tets() == 0) bad("mesh", "the mesh has no tets");
+    materials.validate();
+    for (int r = 0; r < 3; ++r)
+        if (!std::isfinite(gravity[r])) bad("gravity", "non-finite component");
+    non_negative("damping.alpha", rayleigh_alpha);
+    non_negative("damping.beta", rayleigh_beta);
+    if (rayleigh_beta > 0 && integrator == Integrator::Explicit)
+        bad("damping.beta", "stiffness-proportional damping needs an implicit integrator (explicit steps never build K)");
+    if (model == ModelKind::SN && method == Method::Tet) bad("model", "the spring network exists only for the edge method");
+    if (solver.definite_stiffness && method == Method::Tet)
+        bad("solver.definite_stiffness", "the definite tangent exists only for the edge method");
+    positive("dt", dt);
+    if (steps < 0) bad("steps", "must be >= 0");
+    if (prescribed_steps < 1) bad("prescribed.steps", "must be >= 1");
+    positive("solver.cg_tolerance", solver.cg_tolerance);
+    if (solver.cg_max_iterations < 1) bad("solver.cg_max_iterations", "must be >= 1");
+    if (solver.cg_fixed_iterations < 0) bad("solver.cg_fixed_iterations", "must be >= 0");
+    positive("solver.newton_tolerance", solver.newton_tolerance);
+    if (solver.newton_max_iterations < 1) bad("solver.newton_max_iterations", "must be >= 1");
+    if (solver.load_steps < 1) bad("solver.load_steps", "must be >= 1");
+    if (solver.max_step_halvings < 0) bad("solver.max_step_halvings", "must be >= 0");
+    std::vector<char> seen(nv, 0);
+    for (std::size_t i = 0; i < fixed.size(); ++i) {
+        if (fixed[i] < 0 || fixed[i] >= nv)
+            bad("fixed[" + std::to_string(i) + "]", "vertex " + std::to_string(fixed[i]) + " out of range (mesh has " +
+                                                      std::to_string(nv) + " vertices)");
+        seen[fixed[i]] = 1;
+    }
+    for (std::size_t i = 0; i < prescribed.size(); ++i) {
+        const auto& p = prescribed[i];
+        const std::string field = "prescribed[" + std::to_string(i) + "]";
+        if (p.vertex < 0 || p.vertex >= nv)
+            bad(field, "vertex " + std::to_string(p.vertex) + " out of range (mesh has " + std::to_string(nv) + " vertices)");
+        for (int r = 0; r < 3; ++r)
+            if (!std::isfinite(p.target[r])) bad(field, "non-finite target");
+        if (seen[p.vertex] == 2) bad(field, "vertex " + std::to_string(p.vertex) + " prescribed twice");
+        if (seen[p.vertex] == 1) bad(field, "vertex " + std::to_string(p.vertex) + " is also fixed");
+        seen[p.vertex] = 2;
+    }
+}
+
+}  // namespace edgefem

@@ -1,0 +1,508 @@
+#include "edgefem/core/scene_json.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/make_box.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/validate_mesh.hpp"
+#include "text_reader.hpp"
+
+namespace edgefem {
+
+namespace {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---- Messages and typed access ------------------------------------------
+
+// "a" + "b" -> "a.b"; the top level has an empty path.
+std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+std::string item(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
+
+// A value as it appears in the file, shortened for messages.
+std::string show(const json& v) {
+    std::string s = v.dump();
+    if (s.size() > 60) s = s.substr(0, 57) + "...";
+    return s;
+}
+
+std::string num(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
+// What the parser needs besides the JSON: where paths resolve and what
+// messages start with.
+struct Context {
+    std::string source;
+    std::string base_dir;
+
+    [[noreturn]] void fail(const std::string& key, const std::string& message) const {
+        throw InvalidArgument(source + ": \"" + key + "\": " + message);
+    }
+
+    std::string resolve(const std::string& p) const {
+        if (base_dir.empty() || fs::path(p).is_absolute()) return p;
+        return (fs::path(base_dir) / p).lexically_normal().string();
+    }
+};
+
+// Fails on keys outside `allowed` (typos must not pass silently).
+void check_keys(const Context& cx, const json& obj, const std::string& path,
+                std::initializer_list<const char*> allowed) {
+    if (!obj.is_object()) cx.fail(path, "expected an object, got " + show(obj));
+    for (const auto& [key, value] : obj.items()) {
+        if (std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) continue;
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        cx.fail(join(path, key), "unknown key (expected one of: " + list + ")");
+    }
+}
+
+const json* find(const json& obj, const char* key) {
+    const auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+}
+
+enum class Range { Finite, Positive, NonNegative };
+
+double get_number(const Context& cx, const json& v, const std::string& path, Range range = Range::Finite) {
+    const char* want = range == Range::Positive      ? "a positive number"
+                       : range == Range::NonNegative ? "a non-negative number"
+                                                     : "a number";
+    if (!v.is_number()) cx.fail(path, std::string("expected ") + want + ", got " + show(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x) || (range == Range::Positive && !(x > 0)) || (range == Range::NonNegative && !(x >= 0)))
+        cx.fail(path, std::string("expected ") + want + ", got " + show(v));
+    return x;
+}
+
+// Integers may be written as 1000 or 1e3, not as 2.5.
+std::int64_t get_integer(const Context& cx, const json& v, const std::string& path, std::int64_t min,
+                         std::int64_t max = std::numeric_limits<int>::max()) {
+    const std::string want = min == 0 ? "a non-negative integer" : min == 1 ? "a positive integer"
+                                                                            : "an integer >= " + std::to_string(min);
+    double x = 0;
+    if (v.is_number_integer()) {
+        // Unsigned values above int64 cannot be stored; they are out of range anyway.
+        if (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(max)) cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v));
+        x = double(v.get<std::int64_t>());
+    } else if (v.is_number_float()) {
+        x = v.get<double>();
+        if (!std::isfinite(x) || x != std::floor(x)) cx.fail(path, "expected " + want + ", got " + show(v));
+    } else {
+        cx.fail(path, "expected " + want + ", got " + show(v));
+    }
+    if (x < double(min)) cx.fail(path, "expected " + want + ", got " + show(v));
+    if (x > double(max)) cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v));
+    return static_cast<std::int64_t>(x);
+}
+
+int get_int(const Context& cx, const json& v, const std::string& path, int min) {
+    return static_cast<int>(get_integer(cx, v, path, min));
+}
+
+bool get_bool(const Context& cx, const json& v, const std::string& path) {
+    if (!v.is_boolean()) cx.fail(path, "expected true or false, got " + show(v));
+    return v.get<bool>();
+}
+
+std::string get_string(const Context& cx, const json& v, const std::string& path) {
+    if (!v.is_string() || v.get<std::string>().empty()) cx.fail(path, "expected a non-empty string, got " + show(v));
+    return v.get<std::string>();
+}
+
+template <class E>
+E get_enum(const Context& cx, const json& v, const std::string& path,
+           std::initializer_list<std::pair<const char*, E>> names) {
+    if (v.is_string())
+        for (const auto& [name, e] : names)
+            if (v.get<std::string>() == name) return e;
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "\"" : ", \"") + std::string(n.first) + "\"";
+    cx.fail(path, "expected one of " + list + ", got " + show(v));
+}
+
+std::array<double, 3> get_vec3(const Context& cx, const json& v, const std::string& path) {
+    if (!v.is_array() || v.size() != 3) cx.fail(path, "expected an array of 3 numbers, got " + show(v));
+    std::array<double, 3> out;
+    for (std::size_t i = 0; i < 3; ++i) out[i] = get_number(cx, v[i], item(path, i));
+    return out;
+}
+
+// ---- Mesh ------------------------------------------------------------------
+
+// "box:NXxNYxNZ" (0.01 m cubes, as on the command line).
+Mesh box_from_spec(const Context& cx, const std::string& spec, const std::string& path) {
+    index_t n[3];
+    const char* p = spec.data() + 4;
+    const char* end = spec.data() + spec.size();
+    for (int i = 0; i < 3; ++i) {
+        const auto [next, ec] = std::from_chars(p, end, n[i]);
+        if (ec != std::errc() || n[i] <= 0 || (i < 2 && (next == end || (*next != 'x' && *next != 'X'))))
+            cx.fail(path, "bad box mesh '" + spec + "': expected box:NXxNYxNZ with positive integers, e.g. box:10x5x4");
+        p = next + (i < 2 ? 1 : 0);
+    }
+    if (p != end) cx.fail(path, "bad box mesh '" + spec + "': expected box:NXxNYxNZ with positive integers, e.g. box:10x5x4");
+    return make_box(n[0], n[1], n[2]);
+}
+
+Mesh read_scene_mesh(const Context& cx, const json& v, std::vector<std::string>& warnings) {
+    const std::string key = "mesh";
+    try {
+        if (v.is_string()) {
+            const std::string s = get_string(cx, v, key);
+            if (s.rfind("box:", 0) == 0) return box_from_spec(cx, s, key);
+            ReadReport report;
+            Mesh m = read_mesh(cx.resolve(s), MeshFormat::Auto, &report);
+            warnings.insert(warnings.end(), report.warnings.begin(), report.warnings.end());
+            return m;
+        }
+        check_keys(cx, v, key, {"box"});
+        const json* box = find(v, "box");
+        if (!box) cx.fail(key, "expected a path, \"box:NXxNYxNZ\" or {\"box\": {\"cells\": [nx, ny, nz], \"cell\": h}}");
+        const std::string bkey = join(key, "box");
+        check_keys(cx, *box, bkey, {"cells", "cell"});
+        const json* cells = find(*box, "cells");
+        if (!cells) cx.fail(join(bkey, "cells"), "required key missing");
+        if (!cells->is_array() || cells->size() != 3)
+            cx.fail(join(bkey, "cells"), "expected an array of 3 positive integers, got " + show(*cells));
+        index_t n[3];
+        for (std::size_t i = 0; i < 3; ++i) n[i] = index_t(get_integer(cx, (*cells)[i], item(join(bkey, "cells"), i), 1));
+        const json* cell = find(*box, "cell");
+        const double h = cell ? get_number(cx, *cell, join(bkey, "cell"), Range::Positive) : 0.01;
+        try {
+            return make_box(n[0], n[1], n[2], h);
+        } catch (const InvalidArgument& e) {
+            cx.fail(bkey, e.what());  // e.g. too many tets
+        }
+    } catch (const MeshError& e) {
+        // The key and scene file first, then the mesh file's own file:line.
+        throw MeshError(cx.source + ": \"" + key + "\": " + e.what(), {}, 0, e.element());
+    }
+}
+
+// ---- Vertex selections -----------------------------------------------------
+
+// Maps the mesh's vertex numbering as read to the numbering after
+// validation (compaction removes unused vertices, keeping the order).
+struct Renumbering {
+    index_t read_count = 0;
+    std::vector<index_t> to_final;  // empty: identity
+
+    index_t operator()(index_t v) const { return to_final.empty() ? v : to_final[v]; }
+};
+
+Renumbering compaction_map(const Mesh& read, bool compact) {
+    Renumbering r;
+    r.read_count = read.num_vertices();
+    if (!compact) return r;
+    std::vector<char> used(r.read_count, 0);
+    for (index_t v : read.tets)
+        if (v >= 0 && v < r.read_count) used[v] = 1;
+    r.to_final.assign(r.read_count, -1);
+    index_t next = 0;
+    for (index_t v = 0; v < r.read_count; ++v)
+        if (used[v]) r.to_final[v] = next++;
+    return r;
+}
+
+std::string out_of_range(std::int64_t v, index_t count) {
+    return "vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(count) + " vertices)";
+}
+
+// One parsed line of a fixed (index) or prescribed (index x y z) file.
+struct IndexLine {
+    index_t vertex;
+    std::array<double, 3> xyz;
+    std::int64_t line;
+};
+
+// The one parser of both files: '#' comments and blank lines skipped, every
+// other line exactly `1 + coords` tokens with an in-range vertex index.
+std::vector<IndexLine> read_index_file(const Context& cx, const std::string& key, const std::string& file,
+                                       int coords, index_t count) {
+    const std::string path = cx.resolve(file);
+    const char* what = coords ? "'index x y z'" : "a vertex index";
+    std::vector<IndexLine> out;
+    try {
+        detail::TextReader r(path, '#');
+        while (r.next_line()) {
+            auto tok = r.tokens();
+            IndexLine l{};
+            l.line = r.line_no();
+            const std::int64_t v = r.next_int(tok, "vertex index");
+            if (v < 0 || v >= count) r.fail(out_of_range(v, count));
+            l.vertex = index_t(v);
+            for (int c = 0; c < coords; ++c) {
+                l.xyz[c] = r.next_double(tok, "coordinate");
+                if (!std::isfinite(l.xyz[c])) r.fail("non-finite coordinate");
+            }
+            r.expect_end(tok, what);
+            out.push_back(l);
+        }
+        if (out.empty()) r.fail(std::string("no lines: expected ") + what + " per line");
+    } catch (const MeshError& e) {
+        cx.fail(key, e.what());
+    }
+    return out;
+}
+
+// Every vertex whose rest position lies in [lo, hi] (bounds inclusive).
+std::vector<index_t> select_in_box(const Mesh& mesh, const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+    std::vector<index_t> out;
+    for (index_t v = 0; v < mesh.num_vertices(); ++v) {
+        const double* x = &mesh.X[3 * std::size_t(v)];
+        bool in = true;
+        for (int c = 0; c < 3; ++c) in = in && x[c] >= lo[c] && x[c] <= hi[c];
+        if (in) out.push_back(v);
+    }
+    return out;
+}
+
+// One "fixed" selector: {"file": PATH} | {"vertices": [...]} | {"box": {...}}.
+void add_fixed(const Context& cx, const json& sel, const std::string& path, const Mesh& mesh,
+               const Renumbering& renumber, std::vector<index_t>& fixed) {
+    check_keys(cx, sel, path, {"file", "vertices", "box"});
+    if (sel.size() != 1) cx.fail(path, "expected exactly one of \"file\", \"vertices\", \"box\" (use an array of selectors to combine them), got " + show(sel));
+    const std::size_t before = fixed.size();
+    const auto add = [&](index_t v) {
+        if (renumber(v) >= 0) fixed.push_back(renumber(v));  // compaction dropped unused vertices
+    };
+    if (const json* f = find(sel, "file")) {
+        const std::string key = join(path, "file");
+        for (const IndexLine& l : read_index_file(cx, key, get_string(cx, *f, key), 0, renumber.read_count)) add(l.vertex);
+    } else if (const json* vs = find(sel, "vertices")) {
+        const std::string key = join(path, "vertices");
+        if (!vs->is_array() || vs->empty()) cx.fail(key, "expected a non-empty array of vertex indices, got " + show(*vs));
+        for (std::size_t i = 0; i < vs->size(); ++i) {
+            const std::int64_t v = get_integer(cx, (*vs)[i], item(key, i), 0, std::numeric_limits<std::int64_t>::max());
+            if (v >= renumber.read_count) cx.fail(item(key, i), out_of_range(v, renumber.read_count));
+            add(index_t(v));
+        }
+    } else {
+        const json& box = sel["box"];
+        const std::string key = join(path, "box");
+        check_keys(cx, box, key, {"min", "max"});
+        std::array<double, 3> lo{-kInf, -kInf, -kInf}, hi{kInf, kInf, kInf};
+        if (const json* m = find(box, "min")) lo = get_vec3(cx, *m, join(key, "min"));
+        if (const json* m = find(box, "max")) hi = get_vec3(cx, *m, join(key, "max"));
+        for (int c = 0; c < 3; ++c)
+            if (lo[c] > hi[c]) cx.fail(key, "min[" + std::to_string(c) + "] = " + num(lo[c]) + " exceeds max[" + std::to_string(c) + "] = " + num(hi[c]));
+        const std::vector<index_t> in = select_in_box(mesh, lo, hi);
+        fixed.insert(fixed.end(), in.begin(), in.end());
+    }
+    if (fixed.size() == before) cx.fail(path, "selects no vertex");
+}
+
+// ---- The scene ---------------------------------------------------------
+
+Material read_material(const Context& cx, const json& v, const std::string& path, Material m) {
+    check_keys(cx, v, path, {"young", "poisson", "density"});
+    if (const json* x = find(v, "young")) m.young = get_number(cx, *x, join(path, "young"), Range::Positive);
+    if (const json* x = find(v, "poisson")) {
+        m.poisson = get_number(cx, *x, join(path, "poisson"));
+        if (!(m.poisson > -1 && m.poisson < 0.5)) cx.fail(join(path, "poisson"), "expected a number in (-1, 0.5), got " + show(*x));
+    }
+    if (const json* x = find(v, "density")) m.density = get_number(cx, *x, join(path, "density"), Range::Positive);
+    return m;
+}
+
+void read_solver(const Context& cx, const json& v, SolverSettings& s) {
+    const std::string p = "solver";
+    check_keys(cx, v, p,
+               {"linear", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "definite_stiffness",
+                "newton_tolerance", "newton_max_iterations", "load_steps", "max_step_halvings"});
+    if (const json* x = find(v, "linear"))
+        s.linear_solver = get_enum<LinearSolver>(cx, *x, join(p, "linear"), {{"cg", LinearSolver::CG}, {"direct", LinearSolver::Direct}});
+    if (const json* x = find(v, "cg_tolerance")) s.cg_tolerance = get_number(cx, *x, join(p, "cg_tolerance"), Range::Positive);
+    if (const json* x = find(v, "cg_max_iterations")) s.cg_max_iterations = get_int(cx, *x, join(p, "cg_max_iterations"), 1);
+    if (const json* x = find(v, "cg_fixed_iterations")) s.cg_fixed_iterations = get_int(cx, *x, join(p, "cg_fixed_iterations"), 0);
+    if (const json* x = find(v, "definite_stiffness")) s.definite_stiffness = get_bool(cx, *x, join(p, "definite_stiffness"));
+    if (const json* x = find(v, "newton_tolerance")) s.newton_tolerance = get_number(cx, *x, join(p, "newton_tolerance"), Range::Positive);
+    if (const json* x = find(v, "newton_max_iterations")) s.newton_max_iterations = get_int(cx, *x, join(p, "newton_max_iterations"), 1);
+    if (const json* x = find(v, "load_steps")) s.load_steps = get_int(cx, *x, join(p, "load_steps"), 1);
+    if (const json* x = find(v, "max_step_halvings")) s.max_step_halvings = get_int(cx, *x, join(p, "max_step_halvings"), 0);
+}
+
+void read_output(const Context& cx, const json& v, OutputSettings& o) {
+    const std::string p = "output";
+    check_keys(cx, v, p, {"dir", "every", "vtu"});
+    if (const json* x = find(v, "dir")) o.dir = get_string(cx, *x, join(p, "dir"));  // relative to the current directory
+    if (const json* x = find(v, "every")) o.every = get_int(cx, *x, join(p, "every"), 1);
+    if (const json* x = find(v, "vtu")) o.vtu = get_bool(cx, *x, join(p, "vtu"));
+}
+
+void read_prescribed(const Context& cx, const json& v, const Renumbering& renumber, Scene& scene) {
+    const std::string p = "prescribed";
+    check_keys(cx, v, p, {"file", "steps"});
+    const json* f = find(v, "file");
+    if (!f) cx.fail(join(p, "file"), "required key missing");
+    const std::string key = join(p, "file");
+    const std::string file = get_string(cx, *f, key);
+    std::map<index_t, std::int64_t> seen;  // vertex -> line
+    for (const IndexLine& l : read_index_file(cx, key, file, 3, renumber.read_count)) {
+        if (const auto [it, fresh] = seen.emplace(l.vertex, l.line); !fresh)
+            cx.fail(key, cx.resolve(file) + ":" + std::to_string(l.line) + ": vertex " + std::to_string(l.vertex) +
+                             " already prescribed on line " + std::to_string(it->second));
+        if (renumber(l.vertex) >= 0) scene.prescribed.push_back({renumber(l.vertex), l.xyz});
+    }
+    if (const json* s = find(v, "steps")) scene.prescribed_steps = get_int(cx, *s, join(p, "steps"), 1);
+}
+
+SceneFile parse(const Context& cx, const json& root) {
+    if (!root.is_object()) throw InvalidArgument(cx.source + ": expected a JSON object at the top level, got " + show(root));
+    check_keys(cx, root, "",
+               {"mesh", "mesh_options", "material", "regions", "model", "method", "gravity", "damping", "fixed",
+                "prescribed", "integrator", "dt", "steps", "solver", "output"});
+    SceneFile sf;
+    Scene& s = sf.scene;
+
+    // The mesh first: the selectors need it.
+    ValidationOptions vopt;
+    if (const json* o = find(root, "mesh_options")) {
+        check_keys(cx, *o, "mesh_options", {"fix_orientation", "compact"});
+        if (const json* x = find(*o, "fix_orientation")) vopt.fix_orientation = get_bool(cx, *x, "mesh_options.fix_orientation");
+        if (const json* x = find(*o, "compact")) vopt.compact_unreferenced = get_bool(cx, *x, "mesh_options.compact");
+    }
+    const json* mesh = find(root, "mesh");
+    if (!mesh) cx.fail("mesh", "required key missing");
+    s.mesh = read_scene_mesh(cx, *mesh, sf.warnings);
+    const Renumbering renumber = compaction_map(s.mesh, vopt.compact_unreferenced);
+    try {
+        const ValidationReport report = validate_mesh(s.mesh, vopt);
+        sf.warnings.insert(sf.warnings.end(), report.warnings.begin(), report.warnings.end());
+    } catch (const MeshError& e) {
+        throw MeshError(cx.source + ": \"mesh\": " + e.what(), {}, 0, e.element());
+    }
+
+    if (const json* x = find(root, "material")) s.materials.fallback = read_material(cx, *x, "material", Material{});
+    if (const json* x = find(root, "regions")) {
+        if (!x->is_object()) cx.fail("regions", "expected an object {\"<region id>\": {material}, ...}, got " + show(*x));
+        std::set<int> present;
+        for (index_t t = 0; t < s.mesh.num_tets(); ++t) present.insert(s.mesh.tet_region(t));
+        for (const auto& [id, m] : x->items()) {
+            const std::string key = join("regions", id);
+            int region = 0;
+            const auto [end, ec] = std::from_chars(id.data(), id.data() + id.size(), region);
+            if (ec != std::errc() || end != id.data() + id.size()) cx.fail(key, "region ids are integers, got \"" + id + "\"");
+            // Unset fields come from "material".
+            s.materials.by_region[region] = read_material(cx, m, key, s.materials.fallback);
+            if (!present.count(region))
+                sf.warnings.push_back(cx.source + ": \"" + key + "\": no tet of the mesh has region " + id);
+        }
+    }
+    if (const json* x = find(root, "model"))
+        s.model = get_enum<ModelKind>(cx, *x, "model", {{"fe", ModelKind::FE}, {"sn", ModelKind::SN}});
+    if (const json* x = find(root, "method"))
+        s.method = get_enum<Method>(cx, *x, "method", {{"edge", Method::Edge}, {"tet", Method::Tet}});
+    if (const json* x = find(root, "gravity")) s.gravity = get_vec3(cx, *x, "gravity");
+    if (const json* x = find(root, "damping")) {
+        check_keys(cx, *x, "damping", {"alpha", "beta"});
+        if (const json* a = find(*x, "alpha")) s.rayleigh_alpha = get_number(cx, *a, "damping.alpha", Range::NonNegative);
+        if (const json* b = find(*x, "beta")) s.rayleigh_beta = get_number(cx, *b, "damping.beta", Range::NonNegative);
+    }
+    if (const json* x = find(root, "fixed")) {
+        if (x->is_array()) {
+            if (x->empty()) cx.fail("fixed", "expected a selector or a non-empty array of selectors, got []");
+            for (std::size_t i = 0; i < x->size(); ++i) add_fixed(cx, (*x)[i], item("fixed", i), s.mesh, renumber, s.fixed);
+        } else {
+            add_fixed(cx, *x, "fixed", s.mesh, renumber, s.fixed);
+        }
+        // Selectors unite.
+        std::sort(s.fixed.begin(), s.fixed.end());
+        s.fixed.erase(std::unique(s.fixed.begin(), s.fixed.end()), s.fixed.end());
+    }
+    if (const json* x = find(root, "prescribed")) read_prescribed(cx, *x, renumber, s);
+    if (const json* x = find(root, "integrator"))
+        s.integrator = get_enum<Integrator>(cx, *x, "integrator",
+                                            {{"explicit", Integrator::Explicit},
+                                             {"semi-implicit", Integrator::SemiImplicit},
+                                             {"implicit", Integrator::Implicit}});
+    if (const json* x = find(root, "dt")) s.dt = get_number(cx, *x, "dt", Range::Positive);
+    if (const json* x = find(root, "steps")) s.steps = get_int(cx, *x, "steps", 0);
+    if (const json* x = find(root, "solver")) read_solver(cx, *x, s.solver);
+    if (const json* x = find(root, "output")) read_output(cx, *x, sf.output);
+
+    // What only the whole scene can tell (e.g. a vertex both fixed and prescribed).
+    try {
+        s.validate();
+    } catch (const InvalidArgument& e) {
+        std::string what = e.what();
+        if (what.rfind("scene: ", 0) == 0) what.erase(0, 7);  // the file name says it
+        throw InvalidArgument(cx.source + ": " + what);
+    }
+    return sf;
+}
+
+}  // namespace
+
+SceneFile parse_scene(const std::string& text, const std::string& base_dir, const std::string& source_name) {
+    const Context cx{source_name, base_dir};
+    json root;
+    try {
+        root = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    } catch (const json::parse_error& e) {
+        // Drop nlohmann's "[json.exception.parse_error.101] " tag.
+        std::string what = e.what();
+        if (const auto p = what.find("] "); what.rfind("[json.exception", 0) == 0 && p != std::string::npos) what.erase(0, p + 2);
+        throw InvalidArgument(source_name + ": invalid JSON: " + what);
+    }
+    SceneFile sf = parse(cx, root);
+    sf.path = source_name;
+    return sf;
+}
+
+SceneFile load_scene(const std::string& path) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw InvalidArgument(path + ": is a directory, not a scene file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InvalidArgument(path + ": cannot open scene file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw InvalidArgument(path + ": error while reading the scene file");
+    SceneFile sf = parse_scene(text.str(), fs::path(path).parent_path().string(), path);
+    sf.path = path;
+    return sf;
+}
+
+Scene default_scene() {
+    Scene s;
+    s.mesh = make_box(40, 10, 8, 0.005);
+    s.materials = Material{1e5, 0.3, 1000};
+    s.gravity = {0, 0, -9.81};
+    double xmin = kInf;
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v) xmin = std::min(xmin, s.mesh.X[3 * std::size_t(v)]);
+    s.fixed = select_in_box(s.mesh, {-kInf, -kInf, -kInf}, {xmin + 1e-9, kInf, kInf});
+    s.integrator = Integrator::SemiImplicit;
+    s.dt = 1e-3;
+    s.steps = 1000;
+    s.solver.cg_tolerance = 1e-6;
+    return s;
+}
+
+SceneFile default_scene_file() {
+    SceneFile sf;
+    sf.scene = default_scene();
+    sf.output.every = 20;
+    return sf;
+}
+
+}  // namespace edgefem

@@ -1,0 +1,548 @@
+#include "edgefem/core/simulator.hpp"
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "edgefem/core/cg.hpp"
+#include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/sparse_assembly.hpp"
+
+namespace edgefem {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// A failed step, caught to retry with a halved step.
+struct StepFailure {
+    std::string message;
+    index_t vertex;
+};
+
+}  // namespace
+
+template <class S>
+struct Simulator<S>::Impl {
+    Scene scene;
+    std::unique_ptr<ElasticOperator<S>> op;
+    std::unique_ptr<ElasticOperator<S>> op_damp;  // K frozen at the step start (implicit, beta > 0)
+    std::vector<double> mass;                     // #V
+    std::vector<S> u, v, fext, f;                 // 3 #V
+    std::vector<std::uint8_t> free_dof;           // 3 #V
+    std::vector<index_t> con_vertex;              // fixed and prescribed vertices
+    std::vector<std::array<double, 3>> con_disp;  // their final displacement
+    StepStats stats;
+    long step = 0;
+    double time = 0;
+
+    // Scratch.
+    std::vector<double> h, x, b, Ax, Dinv;
+    std::vector<S> xs, ys;
+    CgWork cg;
+    std::vector<index_t> dof_index;
+
+    std::size_t n() const { return u.size(); }
+
+    explicit Impl(Scene s) : scene(std::move(s)) {
+        scene.validate();
+        const Mesh& mesh = scene.mesh;
+        op = make_elastic_operator<S>(mesh, scene.materials, scene.model, scene.method);
+        mass = edgefem::lumped_mass(mesh, scene.materials);
+        const std::size_t nd = 3 * std::size_t(mesh.num_vertices());
+        u.assign(nd, S(0));
+        v.assign(nd, S(0));
+        fext.assign(nd, S(0));
+        f.assign(nd, S(0));
+        free_dof.assign(nd, 1);
+        for (index_t vtx : scene.fixed) {
+            con_vertex.push_back(vtx);
+            con_disp.push_back({0, 0, 0});
+        }
+        for (const auto& p : scene.prescribed) {
+            con_vertex.push_back(p.vertex);
+            con_disp.push_back({p.target[0] - mesh.X[3 * std::size_t(p.vertex)],
+                                p.target[1] - mesh.X[3 * std::size_t(p.vertex) + 1],
+                                p.target[2] - mesh.X[3 * std::size_t(p.vertex) + 2]});
+        }
+        for (index_t vtx : con_vertex)
+            for (int r = 0; r < 3; ++r) free_dof[3 * std::size_t(vtx) + r] = 0;
+        for (std::size_t i = 0; i < mass.size(); ++i)
+            if (!(mass[i] > 0))
+                throw InvalidArgument("scene: vertex " + std::to_string(i) + " has no mass (unreferenced vertex?)");
+        h.resize(nd);
+        x.resize(nd);
+        b.resize(nd);
+        Ax.resize(nd);
+        Dinv.resize(9 * std::size_t(mesh.num_vertices()));
+    }
+
+    // External load h = load (M g + f_ext).
+    void external(double load) {
+        for (std::size_t i = 0; i < n(); ++i) h[i] = load * (mass[i / 3] * scene.gravity[i % 3] + double(fext[i]));
+    }
+
+    // Fraction of the prescribed targets reached at time t.
+    double ramp(double t) const {
+        return std::min(1.0, t / (scene.prescribed_steps * scene.dt) * (1 + 1e-12));
+    }
+
+    // y = op x with double vectors (converts for float models).
+    void multiply(const ElasticOperator<S>& K, const double* in, double* out) {
+        if constexpr (std::is_same_v<S, double>) {
+            K.multiply(in, out);
+        } else {
+            xs.resize(n());
+            ys.resize(n());
+            for (std::size_t i = 0; i < n(); ++i) xs[i] = S(in[i]);
+            K.multiply(xs.data(), ys.data());
+            for (std::size_t i = 0; i < n(); ++i) out[i] = double(ys[i]);
+        }
+    }
+
+    // A = c_m M + c_k K + c_b K0.
+    void apply_system(double c_m, double c_k, double c_b, const double* in, double* out) {
+        multiply(*op, in, out);
+        for (std::size_t i = 0; i < n(); ++i) out[i] = c_m * mass[i / 3] * in[i] + c_k * out[i];
+        if (c_b != 0) {
+            multiply(*op_damp, in, Ax.data());
+            for (std::size_t i = 0; i < n(); ++i) out[i] += c_b * Ax[i];
+        }
+    }
+
+    // Block-Jacobi: inverse of each vertex's 3x3 diagonal block of A; a
+    // block that is not positive definite falls back to its mass part so
+    // the preconditioner stays SPD.
+    void build_preconditioner(double c_m, double c_k, double c_b) {
+        std::vector<S> D(9 * mass.size()), D0;
+        op->diagonal_blocks(D.data());
+        if (c_b != 0) {
+            D0.resize(D.size());
+            op_damp->diagonal_blocks(D0.data());
+        }
+        for (std::size_t vtx = 0; vtx < mass.size(); ++vtx) {
+            Eigen::Matrix3d B;
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    B(i, j) = c_k * double(D[9 * vtx + 3 * i + j]) + (c_b != 0 ? c_b * double(D0[9 * vtx + 3 * i + j]) : 0.0) +
+                              (i == j ? c_m * mass[vtx] : 0.0);
+            B = 0.5 * (B + B.transpose());
+            Eigen::LLT<Eigen::Matrix3d> llt(B);
+            Eigen::Matrix3d inv;
+            if (llt.info() == Eigen::Success)
+                inv = llt.solve(Eigen::Matrix3d::Identity());
+            else {
+                const double d = std::max({c_m * mass[vtx], B(0, 0), B(1, 1), B(2, 2), 1e-300});
+                inv = Eigen::Matrix3d::Identity() / d;
+            }
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) Dinv[9 * vtx + 3 * i + j] = inv(i, j);
+        }
+    }
+
+    // Solves A x = b on the free dofs; x holds the constrained values and a
+    // warm start. Builds K (definite if asked) first; on negative curvature
+    // with the plain K it retries once with the definite K.
+    CgResult solve(double c_m, double c_k, double c_b, double tolerance, bool definite) {
+        CgResult res = solve_once(c_m, c_k, c_b, tolerance, definite);
+        if (res.negative_curvature && !definite && scene.method == Method::Edge) {
+            stats.negative_curvature = true;
+            const int its = res.iterations;
+            res = solve_once(c_m, c_k, c_b, tolerance, true);
+            res.iterations += its;
+        }
+        return res;
+    }
+
+    CgResult solve_once(double c_m, double c_k, double c_b, double tolerance, bool definite) {
+        auto t0 = Clock::now();
+        op->build_stiffness(definite);
+        CgResult res;
+        if (scene.solver.linear_solver == LinearSolver::Direct) {
+            const index_t nf = number_free_dofs(free_dof, dof_index);
+            std::vector<std::pair<double, const ElasticOperator<S>*>> terms{{c_k, op.get()}};
+            if (c_b != 0) terms.emplace_back(c_b, op_damp.get());
+            const Eigen::SparseMatrix<double> A = assemble_system(dof_index, nf, c_m, mass, terms);
+            Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(A);
+            stats.stiffness_ms += ms_since(t0);
+            t0 = Clock::now();
+            // rhs = b - A x_constrained
+            std::vector<double> xc(n());
+            for (std::size_t i = 0; i < n(); ++i) xc[i] = free_dof[i] ? 0.0 : x[i];
+            std::vector<double> Ac(n());
+            apply_system(c_m, c_k, c_b, xc.data(), Ac.data());
+            Eigen::VectorXd rhs(nf);
+            for (std::size_t i = 0; i < n(); ++i)
+                if (dof_index[i] >= 0) rhs[dof_index[i]] = b[i] - Ac[i];
+            if (ldlt.info() != Eigen::Success) {
+                res.residual = INFINITY;
+                stats.solve_ms += ms_since(t0);
+                return res;
+            }
+            const Eigen::VectorXd sol = ldlt.solve(rhs);
+            for (std::size_t i = 0; i < n(); ++i)
+                if (dof_index[i] >= 0) x[i] = sol[dof_index[i]];
+            // Indefinite A: LDLT still solves, but report it like CG would.
+            const auto D = ldlt.vectorD();
+            res.negative_curvature = (D.array() <= 0).any();
+            res.residual = (A * sol - rhs).norm() / std::max(rhs.norm(), 1e-300);
+            res.converged = std::isfinite(res.residual) && !res.negative_curvature;
+            stats.solve_ms += ms_since(t0);
+            return res;
+        }
+        build_preconditioner(c_m, c_k, c_b);
+        stats.stiffness_ms += ms_since(t0);
+        t0 = Clock::now();
+        res = conjugate_gradient(
+            n(), free_dof.data(), [&](const double* in, double* out) { apply_system(c_m, c_k, c_b, in, out); },
+            [&](const double* r, double* z) {
+                for (std::size_t vtx = 0; vtx < mass.size(); ++vtx) {
+                    const double* M = &Dinv[9 * vtx];
+                    const double* rv = &r[3 * vtx];
+                    for (int i = 0; i < 3; ++i) z[3 * vtx + i] = M[3 * i] * rv[0] + M[3 * i + 1] * rv[1] + M[3 * i + 2] * rv[2];
+                }
+            },
+            b.data(), x.data(), tolerance, scene.solver.cg_max_iterations, scene.solver.cg_fixed_iterations, cg);
+        stats.solve_ms += ms_since(t0);
+        stats.solver_iterations += res.iterations;
+        return res;
+    }
+
+    double forces(bool energy) {
+        const auto t0 = Clock::now();
+        const double W = op->forces(u.data(), f.data(), energy);
+        stats.force_ms += ms_since(t0);
+        return W;
+    }
+
+    void check_finite(long step_no) const {
+        for (std::size_t i = 0; i < n(); ++i)
+            if (!std::isfinite(double(u[i])) || !std::isfinite(double(v[i])))
+                throw StepFailure{"step " + std::to_string(step_no) + ": non-finite " +
+                                      (std::isfinite(double(u[i])) ? "velocity" : "displacement") + " at vertex " +
+                                      std::to_string(i / 3) + " (unstable: reduce dt or use an implicit integrator)",
+                                  index_t(i / 3)};
+    }
+
+    // Constrained velocities that reach the targets at time t_end.
+    void constrained_velocities(double T, double t_end, double* vel) const {
+        const double s = ramp(t_end);
+        for (std::size_t k = 0; k < con_vertex.size(); ++k)
+            for (int r = 0; r < 3; ++r) {
+                const std::size_t i = 3 * std::size_t(con_vertex[k]) + r;
+                vel[i] = (s * con_disp[k][r] - double(u[i])) / T;
+            }
+    }
+
+    void explicit_step(double T) {
+        forces(false);
+        external(1.0);
+        const double damp = 1 + T * scene.rayleigh_alpha;
+        for (std::size_t i = 0; i < n(); ++i) x[i] = (double(v[i]) + T * (h[i] - double(f[i])) / mass[i / 3]) / damp;
+        constrained_velocities(T, time + T, x.data());
+        for (std::size_t i = 0; i < n(); ++i) {
+            v[i] = S(x[i]);
+            u[i] += S(T * x[i]);
+        }
+    }
+
+    void semi_implicit_step(double T) {
+        forces(false);
+        external(1.0);
+        const double c_m = 1 + T * scene.rayleigh_alpha, c_k = T * scene.rayleigh_beta + T * T;
+        for (std::size_t i = 0; i < n(); ++i) {
+            b[i] = mass[i / 3] * double(v[i]) + T * (h[i] - double(f[i]));
+            x[i] = double(v[i]);  // warm start
+        }
+        constrained_velocities(T, time + T, x.data());
+        const CgResult res = solve(c_m, c_k, 0.0, scene.solver.cg_tolerance, scene.solver.definite_stiffness);
+        stats.residual = res.residual;
+        if (!std::isfinite(res.residual))
+            throw StepFailure{"step " + std::to_string(step + 1) + ": linear solve failed (non-finite residual)", -1};
+        for (std::size_t i = 0; i < n(); ++i) {
+            v[i] = S(x[i]);
+            u[i] += S(T * x[i]);
+        }
+    }
+
+    // Newton on the incremental potential. Static when T == 0: then the
+    // potential is W - load h.u and there is no inertia or damping.
+    void newton(double T, const std::vector<double>& u0, const std::vector<double>& upred) {
+        const bool dynamic = T > 0;
+        const double c_m = dynamic ? 1 / (T * T) + scene.rayleigh_alpha / T : 0.0;
+        const double c_b = dynamic ? scene.rayleigh_beta / T : 0.0;
+        const auto& sv = scene.solver;
+        std::vector<double> R(n()), du(n()), trial(n()), K0d(n());
+
+        // Potential and residual at the current u (u, f updated).
+        auto evaluate = [&](double& phi, double& scale) {
+            const double W = forces(true);
+            phi = W;
+            double fn = 0, hn = 0, in = 0;
+            std::vector<double> d(n());
+            for (std::size_t i = 0; i < n(); ++i) d[i] = double(u[i]) - (dynamic ? u0[i] : 0.0);
+            if (c_b != 0) multiply(*op_damp, d.data(), K0d.data());
+            for (std::size_t i = 0; i < n(); ++i) {
+                double r = double(f[i]) - h[i];
+                phi -= h[i] * double(u[i]);
+                fn += double(f[i]) * double(f[i]);
+                hn += h[i] * h[i];
+                if (dynamic) {
+                    const double m = mass[i / 3], e = double(u[i]) - upred[i];
+                    const double inertia = m * e / (T * T) + scene.rayleigh_alpha * m * d[i] / T + c_b * K0d[i];
+                    r += inertia;
+                    in += inertia * inertia;
+                    phi += 0.5 * m * e * e / (T * T) + 0.5 * scene.rayleigh_alpha * m * d[i] * d[i] / T +
+                           0.5 * c_b * d[i] * K0d[i];
+                }
+                R[i] = free_dof[i] ? r : 0.0;
+            }
+            scale = std::sqrt(fn) + std::sqrt(hn) + std::sqrt(in);
+        };
+
+        double phi = 0, scale = 0;
+        evaluate(phi, scale);
+        for (int it = 0;; ++it) {
+            double rn = 0;
+            for (double r : R) rn += r * r;
+            rn = std::sqrt(rn);
+            stats.residual = scale > 0 ? rn / scale : rn;
+            if (!std::isfinite(rn))
+                throw StepFailure{"step " + std::to_string(step + 1) + ": non-finite residual in Newton", -1};
+            if (rn <= sv.newton_tolerance * scale) return;
+            if (it == sv.newton_max_iterations)
+                throw StepFailure{"step " + std::to_string(step + 1) + ": Newton did not converge in " +
+                                      std::to_string(sv.newton_max_iterations) + " iterations (relative residual " +
+                                      std::to_string(stats.residual) + ")",
+                                  -1};
+            ++stats.newton_iterations;
+            // Solve (c_m M + K + c_b K0) du = -R, du = 0 on constrained dofs.
+            for (std::size_t i = 0; i < n(); ++i) {
+                b[i] = -R[i];
+                x[i] = 0;
+            }
+            const double eta = std::min(1e-2, std::max(1e-12, rn / std::max(scale, 1e-300)));
+            solve(c_m, 1.0, c_b, eta, sv.definite_stiffness);
+            double slope = 0;
+            for (std::size_t i = 0; i < n(); ++i) slope += x[i] * R[i];
+            if (!(slope < 0) || !std::isfinite(slope)) {  // not a descent direction: use the definite K
+                if (scene.method == Method::Edge) {
+                    for (std::size_t i = 0; i < n(); ++i) x[i] = 0;
+                    solve_once(c_m, 1.0, c_b, eta, true);
+                    slope = 0;
+                    for (std::size_t i = 0; i < n(); ++i) slope += x[i] * R[i];
+                }
+                if (!(slope < 0)) {  // last resort: scaled gradient
+                    slope = 0;
+                    for (std::size_t i = 0; i < n(); ++i) {
+                        x[i] = -R[i] / (mass[i / 3] * std::max(c_m, 1.0));
+                        slope += x[i] * R[i];
+                    }
+                }
+            }
+            du.assign(x.begin(), x.end());
+            // Backtracking line search (Armijo) on the potential.
+            for (std::size_t i = 0; i < n(); ++i) trial[i] = double(u[i]);
+            double step_len = 1, phi_new = 0, scale_new = 0;
+            for (int ls = 0;; ++ls) {
+                for (std::size_t i = 0; i < n(); ++i) u[i] = S(trial[i] + step_len * du[i]);
+                evaluate(phi_new, scale_new);
+                if (std::isfinite(phi_new) && phi_new <= phi + 1e-4 * step_len * slope) break;
+                // Round-off floor: near the minimum phi stops resolving changes.
+                if (std::isfinite(phi_new) && std::abs(phi_new - phi) <= 1e-14 * (std::abs(phi) + scale)) break;
+                if (ls == 40)
+                    throw StepFailure{"step " + std::to_string(step + 1) + ": line search failed", -1};
+                step_len *= 0.5;
+            }
+            phi = phi_new;
+            scale = scale_new;
+        }
+    }
+
+    void implicit_step(double T) {
+        external(1.0);
+        std::vector<double> u0(n()), upred(n());
+        for (std::size_t i = 0; i < n(); ++i) {
+            u0[i] = double(u[i]);
+            upred[i] = u0[i] + T * double(v[i]);
+        }
+        if (scene.rayleigh_beta > 0) {
+            if (!op_damp) op_damp = make_elastic_operator<S>(scene.mesh, scene.materials, scene.model, scene.method);
+            std::vector<S> scratch(n());
+            op_damp->forces(u.data(), scratch.data(), false);
+            op_damp->build_stiffness(scene.solver.definite_stiffness);
+        }
+        // Start from the prediction with the constrained dofs at their targets.
+        const double s = ramp(time + T);
+        for (std::size_t i = 0; i < n(); ++i) u[i] = S(upred[i]);
+        for (std::size_t k = 0; k < con_vertex.size(); ++k)
+            for (int r = 0; r < 3; ++r) u[3 * std::size_t(con_vertex[k]) + r] = S(s * con_disp[k][r]);
+        newton(T, u0, upred);
+        for (std::size_t i = 0; i < n(); ++i) v[i] = S((double(u[i]) - u0[i]) / T);
+    }
+
+    void advance(double T, int depth) {
+        const std::vector<S> u_save = u, v_save = v;
+        try {
+            switch (scene.integrator) {
+                case Integrator::Explicit: explicit_step(T); break;
+                case Integrator::SemiImplicit: semi_implicit_step(T); break;
+                case Integrator::Implicit: implicit_step(T); break;
+            }
+            check_finite(step + 1);
+            time += T;
+        } catch (const StepFailure& failure) {
+            if (depth >= scene.solver.max_step_halvings) throw;
+            u = u_save;
+            v = v_save;
+            ++stats.halvings;
+            advance(T / 2, depth + 1);
+            advance(T / 2, depth + 1);
+        }
+    }
+
+    const StepStats& do_step() {
+        stats = StepStats{};
+        const double t_start = time;
+        try {
+            advance(scene.dt, 0);
+        } catch (const StepFailure& failure) {
+            time = t_start;
+            throw SimulationError(failure.message, step + 1, failure.vertex);
+        }
+        time = t_start + scene.dt;  // no drift from summed halves
+        ++step;
+        if (scene.count_inverted_tets) stats.inverted_tets = op->inverted_tets(u.data());
+        return stats;
+    }
+
+    StaticResult do_static() {
+        for (auto& x_ : v) x_ = S(0);
+        if (con_vertex.empty())
+            throw InvalidArgument("static equilibrium needs fixed or prescribed vertices (else it is singular)");
+        stats = StepStats{};
+        StaticResult result;
+        const std::vector<double> none;
+        double done = 0, inc = 1.0 / scene.solver.load_steps;
+        int halvings = 0;
+        while (done < 1 - 1e-15) {
+            const double load = std::min(1.0, done + inc);
+            const std::vector<S> u_save = u;
+            external(load);
+            for (std::size_t k = 0; k < con_vertex.size(); ++k)
+                for (int r = 0; r < 3; ++r) u[3 * std::size_t(con_vertex[k]) + r] = S(load * con_disp[k][r]);
+            try {
+                newton(0.0, none, none);
+            } catch (const StepFailure& failure) {
+                u = u_save;
+                if (++halvings > 12)
+                    throw SimulationError("static solve: " + failure.message + " even with load increment " +
+                                              std::to_string(inc),
+                                          step, failure.vertex);
+                inc /= 2;
+                continue;
+            }
+            done = load;
+            ++result.load_steps;
+        }
+        result.newton_iterations = stats.newton_iterations;
+        result.residual = stats.residual;
+        result.converged = true;
+        if (scene.count_inverted_tets) stats.inverted_tets = op->inverted_tets(u.data());
+        check_finite(step);
+        return result;
+    }
+
+    Energies energies() {
+        Energies e;
+        e.elastic = op->energy(u.data());
+        for (std::size_t i = 0; i < n(); ++i) {
+            const double m = mass[i / 3];
+            e.kinetic += 0.5 * m * double(v[i]) * double(v[i]);
+            e.gravity -= m * scene.gravity[i % 3] * (scene.mesh.X[i] + double(u[i]));
+        }
+        return e;
+    }
+};
+
+template <class S>
+Simulator<S>::Simulator(Scene scene) : impl_(std::make_unique<Impl>(std::move(scene))) {}
+template <class S>
+Simulator<S>::~Simulator() = default;
+template <class S>
+Simulator<S>::Simulator(Simulator&&) noexcept = default;
+template <class S>
+Simulator<S>& Simulator<S>::operator=(Simulator&&) noexcept = default;
+
+template <class S>
+const Scene& Simulator<S>::scene() const {
+    return impl_->scene;
+}
+template <class S>
+index_t Simulator<S>::num_vertices() const {
+    return impl_->scene.mesh.num_vertices();
+}
+template <class S>
+const StepStats& Simulator<S>::step() {
+    return impl_->do_step();
+}
+template <class S>
+StaticResult Simulator<S>::solve_static() {
+    try {
+        return impl_->do_static();
+    } catch (const StepFailure& failure) {
+        throw SimulationError("static solve: " + failure.message, impl_->step, failure.vertex);
+    }
+}
+template <class S>
+std::span<S> Simulator<S>::displacement() {
+    return impl_->u;
+}
+template <class S>
+std::span<S> Simulator<S>::velocity() {
+    return impl_->v;
+}
+template <class S>
+std::span<S> Simulator<S>::external_forces() {
+    return impl_->fext;
+}
+template <class S>
+std::span<const S> Simulator<S>::forces() const {
+    return impl_->f;
+}
+template <class S>
+std::span<const double> Simulator<S>::lumped_mass() const {
+    return impl_->mass;
+}
+template <class S>
+std::vector<double> Simulator<S>::positions() const {
+    std::vector<double> x(impl_->n());
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = impl_->scene.mesh.X[i] + double(impl_->u[i]);
+    return x;
+}
+template <class S>
+Energies Simulator<S>::energies() {
+    return impl_->energies();
+}
+template <class S>
+long Simulator<S>::step_index() const {
+    return impl_->step;
+}
+template <class S>
+double Simulator<S>::time() const {
+    return impl_->time;
+}
+template <class S>
+const StepStats& Simulator<S>::last_stats() const {
+    return impl_->stats;
+}
+
+template class Simulator<double>;
+template class Simulator<float>;
+
+}  // namespace edgefem

@@ -1,0 +1,269 @@
+// Dynamics and statics: conservation laws, convergence orders, equilibrium,
+// the definite tangent, and clear failures.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "edgefem/core/cg.hpp"
+#include "edgefem/core/elastic_operator.hpp"
+#include "edgefem/core/make_box.hpp"
+#include "edgefem/core/simulator.hpp"
+
+using namespace edgefem;
+
+namespace {
+
+// A soft cantilever: 8 x 2 x 2 cubes of 1 cm, clamped at x = min, gravity -z.
+Scene cantilever(Integrator integrator, double dt) {
+    Scene s;
+    s.mesh = make_box(8, 2, 2);
+    s.materials = Material{2e4, 0.3, 1000};
+    s.gravity = {0, 0, -9.81};
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+        if (s.mesh.X[3 * v] < -0.04 + 1e-9) s.fixed.push_back(v);
+    s.integrator = integrator;
+    s.dt = dt;
+    s.solver.cg_tolerance = 1e-10;
+    s.solver.cg_max_iterations = 2000;
+    return s;
+}
+
+double total_mass(const Simulator<double>& sim) {
+    double m = 0;
+    for (double x : sim.lumped_mass()) m += x;
+    return m;
+}
+
+std::vector<double> momentum(Simulator<double>& sim) {
+    std::vector<double> p(3, 0.0);
+    const auto v = sim.velocity();
+    const auto m = sim.lumped_mass();
+    for (std::size_t i = 0; i < v.size(); ++i) p[i % 3] += m[i / 3] * v[i];
+    return p;
+}
+
+}  // namespace
+
+TEST(Simulator, ExplicitSwingConservesEnergyWithinBound) {
+    Simulator<double> sim(cantilever(Integrator::Explicit, 2e-5));
+    const double E0 = sim.energies().total();
+    // Energy scale: the gravity potential released if the beam dropped 1 cm.
+    const double scale = total_mass(sim) * 9.81 * 0.01;
+    double worst = 0;
+    for (int k = 0; k < 5000; ++k) {  // 0.1 s: a good part of a swing
+        sim.step();
+        if (k % 100 == 99) worst = std::max(worst, std::abs(sim.energies().total() - E0));
+    }
+    EXPECT_GT(sim.energies().kinetic, 0);
+    // Symplectic Euler: bounded oscillation, O(dt), no drift.
+    EXPECT_LT(worst, 0.02 * scale);
+}
+
+TEST(Simulator, ImplicitSchemesDissipateAndNeverGainEnergy) {
+    for (Integrator integ : {Integrator::SemiImplicit, Integrator::Implicit}) {
+        SCOPED_TRACE(to_string(integ));
+        Simulator<double> sim(cantilever(integ, 2e-3));
+        double prev = sim.energies().total();
+        const double scale = total_mass(sim) * 9.81 * 0.01;
+        for (int k = 0; k < 50; ++k) {
+            sim.step();
+            const double E = sim.energies().total();
+            EXPECT_LE(E, prev + 1e-6 * scale) << "step " << k;  // backward Euler is dissipative
+            prev = E;
+        }
+    }
+}
+
+TEST(Simulator, MomentumConservedWithoutGravityOrSupports) {
+    for (Integrator integ : {Integrator::Explicit, Integrator::SemiImplicit, Integrator::Implicit}) {
+        SCOPED_TRACE(to_string(integ));
+        Scene s = cantilever(integ, integ == Integrator::Explicit ? 2e-5 : 1e-3);
+        s.fixed.clear();
+        s.gravity = {0, 0, 0};
+        Simulator<double> sim(std::move(s));
+        auto v = sim.velocity();
+        for (std::size_t i = 0; i < v.size(); ++i) v[i] = 0.05 * std::sin(0.7 * i) + (i % 3 == 0 ? 0.02 : 0.0);
+        const auto p0 = momentum(sim);
+        double pscale = 0;
+        for (std::size_t i = 0; i < v.size(); ++i) pscale += sim.lumped_mass()[i / 3] * std::abs(v[i]);
+        for (int k = 0; k < 20; ++k) sim.step();
+        const auto p1 = momentum(sim);
+        for (int r = 0; r < 3; ++r) EXPECT_NEAR(p1[r], p0[r], 1e-8 * pscale);
+    }
+}
+
+TEST(Simulator, SemiImplicitConvergesToImplicitAtFirstOrder) {
+    const double t_end = 0.04;
+    std::vector<double> diffs;
+    for (double dt : {4e-3, 2e-3, 1e-3}) {
+        Simulator<double> semi(cantilever(Integrator::SemiImplicit, dt));
+        Simulator<double> impl(cantilever(Integrator::Implicit, dt));
+        const int n = int(std::lround(t_end / dt));
+        for (int k = 0; k < n; ++k) {
+            semi.step();
+            impl.step();
+        }
+        double d = 0, ref = 0;
+        for (std::size_t i = 0; i < semi.displacement().size(); ++i) {
+            d = std::max(d, std::abs(semi.displacement()[i] - impl.displacement()[i]));
+            ref = std::max(ref, std::abs(impl.displacement()[i]));
+        }
+        diffs.push_back(d / ref);
+    }
+    // Each halving of dt roughly halves the gap (first order).
+    EXPECT_GT(diffs[0] / diffs[1], 1.6);
+    EXPECT_GT(diffs[1] / diffs[2], 1.6);
+    EXPECT_LT(diffs[2], 0.05);
+}
+
+TEST(Simulator, StaticEquilibriumResidualAndReactionsEqualWeight) {
+    for (LinearSolver ls : {LinearSolver::CG, LinearSolver::Direct}) {
+        SCOPED_TRACE(to_string(ls));
+        Scene s = cantilever(Integrator::Implicit, 1e-3);
+        s.solver.linear_solver = ls;
+        s.solver.newton_tolerance = 1e-11;
+        const std::vector<index_t> fixed = s.fixed;
+        Simulator<double> sim(std::move(s));
+        const StaticResult r = sim.solve_static();
+        EXPECT_TRUE(r.converged);
+        EXPECT_GT(r.newton_iterations, 0);
+        // Independent check of equilibrium: f - M g vanishes on free vertices.
+        const auto f = sim.forces();
+        const auto m = sim.lumped_mass();
+        std::vector<char> is_fixed(sim.num_vertices(), 0);
+        for (index_t v : fixed) is_fixed[v] = 1;
+        double res = 0, scale = 0, reaction_z = 0;
+        for (std::size_t i = 0; i < f.size(); ++i) {
+            const double h = (i % 3 == 2) ? -9.81 * m[i / 3] : 0.0;
+            scale += f[i] * f[i];
+            if (!is_fixed[i / 3])
+                res += (f[i] - h) * (f[i] - h);
+            else if (i % 3 == 2)
+                reaction_z += f[i] - h;  // support force on the beam: f = h + reaction
+        }
+        EXPECT_LE(std::sqrt(res), 1e-10 * std::sqrt(scale));
+        // Supports carry the whole weight (vertical reactions sum to m g).
+        EXPECT_NEAR(reaction_z, 9.81 * total_mass(sim), 1e-8 * 9.81 * total_mass(sim));
+        // The beam sags.
+        double min_uz = 0;
+        for (std::size_t i = 2; i < f.size(); i += 3) min_uz = std::min(min_uz, sim.displacement()[i]);
+        EXPECT_LT(min_uz, -1e-4);
+    }
+}
+
+TEST(Simulator, DefiniteTangentKeepsCgConvergentOnCompressedCube) {
+    const Mesh mesh = make_box(4, 4, 4);
+    auto plain = make_elastic_operator<double>(mesh, Material{1e5, 0.3, 1000}, ModelKind::FE, Method::Edge);
+    // Compress to 20% of the height, with a small shear so the state is generic.
+    std::vector<double> u(mesh.X.size());
+    for (index_t v = 0; v < mesh.num_vertices(); ++v) {
+        u[3 * v + 2] = -0.8 * (mesh.X[3 * v + 2] + 0.02);
+        u[3 * v] = 0.05 * mesh.X[3 * v + 2];
+    }
+    std::vector<double> f(u.size());
+    plain->forces(u.data(), f.data(), false);
+    std::vector<std::uint8_t> free_dof(u.size(), 1);
+    for (index_t v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.X[3 * v + 2] < -0.02 + 1e-9) free_dof[3 * v] = free_dof[3 * v + 1] = free_dof[3 * v + 2] = 0;
+    std::vector<double> b(u.size());
+    for (std::size_t i = 0; i < b.size(); ++i) b[i] = std::cos(0.3 * i);
+    // (identity preconditioner: z = r)
+    auto run_id = [&](bool definite) {
+        plain->build_stiffness(definite);
+        std::vector<double> x(u.size(), 0.0);
+        CgWork w;
+        const std::size_t n = u.size();
+        return conjugate_gradient(
+            n, free_dof.data(), [&](const double* in, double* out) { plain->multiply(in, out); },
+            [n](const double* r, double* z) { std::copy(r, r + n, z); }, b.data(), x.data(), 1e-8, 5000, 0, w);
+    };
+    const CgResult p = run_id(false), d = run_id(true);
+    EXPECT_TRUE(p.negative_curvature);
+    EXPECT_FALSE(p.converged);
+    EXPECT_FALSE(d.negative_curvature);
+    EXPECT_TRUE(d.converged);
+
+    // Inside the simulator the plain K's failure is detected and handled: a
+    // big step from the compressed state stays finite and reports it.
+    Scene s;
+    s.mesh = mesh;
+    s.materials = Material{1e5, 0.3, 1000};
+    for (index_t v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.X[3 * v + 2] < -0.02 + 1e-9) s.fixed.push_back(v);
+    s.dt = 0.05;
+    Simulator<double> sim(s);
+    std::copy(u.begin(), u.end(), sim.displacement().begin());
+    for (index_t v : s.fixed)
+        for (int r = 0; r < 3; ++r) sim.displacement()[3 * v + r] = 0;
+    const StepStats& st = sim.step();
+    EXPECT_TRUE(st.negative_curvature);
+    for (double x : sim.displacement()) ASSERT_TRUE(std::isfinite(x));
+}
+
+TEST(Simulator, ExplicitBlowUpIsAClearError) {
+    Scene s = cantilever(Integrator::Explicit, 5e-2);  // far beyond the stable step
+    s.materials = Material{1e7, 0.3, 1000};
+    Simulator<double> sim(std::move(s));
+    try {
+        for (int k = 0; k < 1000; ++k) sim.step();
+        FAIL() << "no error";
+    } catch (const SimulationError& e) {
+        EXPECT_GT(e.step(), 0);
+        EXPECT_GE(e.vertex(), 0);
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("step " + std::to_string(e.step())), std::string::npos) << msg;
+        EXPECT_NE(msg.find("vertex " + std::to_string(e.vertex())), std::string::npos) << msg;
+    }
+}
+
+TEST(Simulator, StepHalvingRecoversWhereAPlainStepFails) {
+    Scene s = cantilever(Integrator::Implicit, 5e-2);
+    s.solver.newton_max_iterations = 3;
+    Simulator<double> plain(s);
+    EXPECT_THROW(plain.step(), SimulationError);
+    s.solver.max_step_halvings = 6;
+    Simulator<double> halving(s);
+    const StepStats& st = halving.step();
+    EXPECT_GT(st.halvings, 0);
+    EXPECT_NEAR(halving.time(), 5e-2, 1e-15);
+}
+
+TEST(Simulator, FloatTracksDoubleAndSceneErrorsNameTheField) {
+    Simulator<double> d(cantilever(Integrator::SemiImplicit, 1e-3));
+    Simulator<float> f(cantilever(Integrator::SemiImplicit, 1e-3));
+    for (int k = 0; k < 20; ++k) {
+        d.step();
+        f.step();
+    }
+    double diff = 0, ref = 0;
+    for (std::size_t i = 0; i < d.displacement().size(); ++i) {
+        diff = std::max(diff, std::abs(d.displacement()[i] - double(f.displacement()[i])));
+        ref = std::max(ref, std::abs(d.displacement()[i]));
+    }
+    EXPECT_LT(diff, 1e-4 * ref);
+
+    auto expect_field = [](Scene s, const char* field) {
+        try {
+            Simulator<double> sim(std::move(s));
+            ADD_FAILURE() << "accepted bad " << field;
+        } catch (const InvalidArgument& e) {
+            EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+        }
+    };
+    Scene s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.dt = -1;
+    expect_field(s, "\"dt\"");
+    s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.fixed.push_back(100000);
+    expect_field(s, "fixed[");
+    s = cantilever(Integrator::Explicit, 1e-3);
+    s.rayleigh_beta = 0.1;
+    expect_field(s, "damping.beta");
+    s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.solver.cg_tolerance = 0;
+    expect_field(s, "solver.cg_tolerance");
+    s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.method = Method::Tet;
+    s.model = ModelKind::SN;
+    expect_field(s, "model");
+}
