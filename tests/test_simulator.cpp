@@ -174,7 +174,7 @@ TEST(Simulator, DefiniteTangentKeepsCgConvergentOnCompressedCube) {
         CgWork w;
         const std::size_t n = u.size();
         return conjugate_gradient(
-            n, free_dof.data(), [&](const double* in, double* out) { plain->multiply(in, out); },
+            SerialExecutor{}, n, free_dof.data(), [&](const double* in, double* out) { plain->multiply(in, out); },
             [n](const double* r, double* z) { std::copy(r, r + n, z); }, b.data(), x.data(), 1e-8, 5000, 0, w);
     };
     const CgResult p = run_id(false), d = run_id(true);

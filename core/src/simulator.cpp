@@ -30,6 +30,8 @@ struct StepFailure {
 template <class S>
 struct Simulator<S>::Impl {
     Scene scene;
+    std::shared_ptr<const Executor> exec;
+    OperatorFactory<S> factory;
     std::unique_ptr<ElasticOperator<S>> op;
     std::unique_ptr<ElasticOperator<S>> op_damp;  // K frozen at the step start (implicit, beta > 0)
     std::vector<double> mass;                     // #V
@@ -49,10 +51,15 @@ struct Simulator<S>::Impl {
 
     std::size_t n() const { return u.size(); }
 
-    explicit Impl(Scene s) : scene(std::move(s)) {
+    Impl(Scene s, std::shared_ptr<const Executor> e, OperatorFactory<S> make_op)
+        : scene(std::move(s)), exec(std::move(e)), factory(std::move(make_op)) {
         scene.validate();
+        if (!exec) exec = std::make_shared<SerialExecutor>();
+        if (!factory) factory = [](const Mesh& m, const Materials& mat, ModelKind k, Method me) {
+            return make_elastic_operator<S>(m, mat, k, me);
+        };
         const Mesh& mesh = scene.mesh;
-        op = make_elastic_operator<S>(mesh, scene.materials, scene.model, scene.method);
+        op = factory(mesh, scene.materials, scene.model, scene.method);
         mass = edgefem::lumped_mass(mesh, scene.materials);
         const std::size_t nd = 3 * std::size_t(mesh.num_vertices());
         u.assign(nd, S(0));
@@ -199,7 +206,7 @@ struct Simulator<S>::Impl {
         stats.stiffness_ms += ms_since(t0);
         t0 = Clock::now();
         res = conjugate_gradient(
-            n(), free_dof.data(), [&](const double* in, double* out) { apply_system(c_m, c_k, c_b, in, out); },
+            *exec, n(), free_dof.data(), [&](const double* in, double* out) { apply_system(c_m, c_k, c_b, in, out); },
             [&](const double* r, double* z) {
                 for (std::size_t vtx = 0; vtx < mass.size(); ++vtx) {
                     const double* M = &Dinv[9 * vtx];
@@ -372,7 +379,7 @@ struct Simulator<S>::Impl {
             upred[i] = u0[i] + T * double(v[i]);
         }
         if (scene.rayleigh_beta > 0) {
-            if (!op_damp) op_damp = make_elastic_operator<S>(scene.mesh, scene.materials, scene.model, scene.method);
+            if (!op_damp) op_damp = factory(scene.mesh, scene.materials, scene.model, scene.method);
             std::vector<S> scratch(n());
             op_damp->forces(u.data(), scratch.data(), false);
             op_damp->build_stiffness(scene.solver.definite_stiffness);
@@ -471,7 +478,8 @@ struct Simulator<S>::Impl {
 };
 
 template <class S>
-Simulator<S>::Simulator(Scene scene) : impl_(std::make_unique<Impl>(std::move(scene))) {}
+Simulator<S>::Simulator(Scene scene, std::shared_ptr<const Executor> executor, OperatorFactory<S> factory)
+    : impl_(std::make_unique<Impl>(std::move(scene), std::move(executor), std::move(factory))) {}
 template <class S>
 Simulator<S>::~Simulator() = default;
 template <class S>

@@ -1,12 +1,15 @@
 // Preconditioned conjugate gradients on a projected system: constrained
 // degrees of freedom keep the value they have in x on entry, the others solve
-// P A P x = P b. Matrix-free: A and the preconditioner are callables. Dot
-// products accumulate in double, in index order (deterministic).
+// P A P x = P b. Matrix-free: A and the preconditioner are callables. The
+// vector updates run as fixed blocks on the executor and dot products sum
+// per-block partials in block order: bitwise the same for any thread count.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <vector>
+
+#include "edgefem/core/executor.hpp"
 
 namespace edgefem {
 
@@ -26,25 +29,26 @@ struct CgWork {
 // z = M^-1 r. `fixed_iterations` > 0 runs exactly that many iterations
 // (unless the residual vanishes), ignoring the tolerance.
 template <class ApplyA, class ApplyM>
-CgResult conjugate_gradient(std::size_t n, const std::uint8_t* free_dof, ApplyA&& apply_A, ApplyM&& apply_M,
-                            const double* b, double* x, double tolerance, int max_iterations,
+CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_t* free_dof, ApplyA&& apply_A,
+                            ApplyM&& apply_M, const double* b, double* x, double tolerance, int max_iterations,
                             int fixed_iterations, CgWork& w) {
     w.r.resize(n);
     w.z.resize(n);
     w.p.resize(n);
     w.Ap.resize(n);
-    auto dot = [n](const std::vector<double>& a, const std::vector<double>& c) {
-        double s = 0;
-        for (std::size_t i = 0; i < n; ++i) s += a[i] * c[i];
-        return s;
+    auto dot = [&](const std::vector<double>& a, const std::vector<double>& c) {
+        return blocked_sum(ex, n, [&](std::size_t i) { return a[i] * c[i]; });
     };
-    double bnorm = 0;
-    for (std::size_t i = 0; i < n; ++i) bnorm += free_dof[i] ? b[i] * b[i] : 0.0;
-    bnorm = std::sqrt(bnorm);
+    auto each = [&](auto&& body) {
+        for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) {
+            for (std::size_t i = lo; i < hi; ++i) body(i);
+        });
+    };
+    const double bnorm = std::sqrt(blocked_sum(ex, n, [&](std::size_t i) { return free_dof[i] ? b[i] * b[i] : 0.0; }));
     const double scale = bnorm > 0 ? bnorm : 1.0;
 
     apply_A(x, w.Ap.data());
-    for (std::size_t i = 0; i < n; ++i) w.r[i] = free_dof[i] ? b[i] - w.Ap[i] : 0.0;
+    each([&](std::size_t i) { w.r[i] = free_dof[i] ? b[i] - w.Ap[i] : 0.0; });
     CgResult res;
     res.residual = std::sqrt(dot(w.r, w.r)) / scale;
     const int limit = fixed_iterations > 0 ? fixed_iterations : max_iterations;
@@ -53,33 +57,35 @@ CgResult conjugate_gradient(std::size_t n, const std::uint8_t* free_dof, ApplyA&
         return res;
     }
     apply_M(w.r.data(), w.z.data());
-    for (std::size_t i = 0; i < n; ++i) w.p[i] = free_dof[i] ? w.z[i] : 0.0;
+    each([&](std::size_t i) { w.p[i] = free_dof[i] ? w.z[i] : 0.0; });
     double rz = dot(w.r, w.p);
     for (int it = 0; it < limit; ++it) {
         if (res.residual == 0) break;
         apply_A(w.p.data(), w.Ap.data());
-        for (std::size_t i = 0; i < n; ++i)
+        each([&](std::size_t i) {
             if (!free_dof[i]) w.Ap[i] = 0;
+        });
         const double pAp = dot(w.p, w.Ap);
         if (!(pAp > 0)) {  // also catches NaN
             res.negative_curvature = true;
             break;
         }
         const double alpha = rz / pAp;
-        for (std::size_t i = 0; i < n; ++i) {
+        each([&](std::size_t i) {
             x[i] += alpha * w.p[i];
             w.r[i] -= alpha * w.Ap[i];
-        }
+        });
         ++res.iterations;
         res.residual = std::sqrt(dot(w.r, w.r)) / scale;
         if (fixed_iterations == 0 && res.residual <= tolerance) break;
         apply_M(w.r.data(), w.z.data());
-        for (std::size_t i = 0; i < n; ++i)
+        each([&](std::size_t i) {
             if (!free_dof[i]) w.z[i] = 0;
+        });
         const double rz_new = dot(w.r, w.z);
         const double beta = rz_new / rz;
         rz = rz_new;
-        for (std::size_t i = 0; i < n; ++i) w.p[i] = w.z[i] + beta * w.p[i];
+        each([&](std::size_t i) { w.p[i] = w.z[i] + beta * w.p[i]; });
     }
     res.converged = !res.negative_curvature && res.residual <= tolerance;
     return res;

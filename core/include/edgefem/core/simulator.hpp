@@ -8,7 +8,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include <functional>
+
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/executor.hpp"
 #include "edgefem/core/scene.hpp"
 
 namespace edgefem {
@@ -51,12 +54,22 @@ struct StaticResult {
     bool converged = false;
 };
 
+// Builds the elastic model a simulator uses; parallel/ provides factories
+// that run the kernels on OpenMP or TBB. The default is make_elastic_operator
+// (serial).
+template <class S>
+using OperatorFactory =
+    std::function<std::unique_ptr<ElasticOperator<S>>(const Mesh&, const Materials&, ModelKind, Method)>;
+
 template <class S>
 class Simulator {
 public:
     // Validates the scene (InvalidArgument naming the field) and sets up the
-    // model; the state starts at rest (u = 0, v = 0).
-    explicit Simulator(Scene scene);
+    // model; the state starts at rest (u = 0, v = 0). `executor` runs the
+    // solver's vector operations (serial when null); `factory` builds the
+    // elastic model (serial kernels when empty).
+    explicit Simulator(Scene scene, std::shared_ptr<const Executor> executor = nullptr,
+                       OperatorFactory<S> factory = {});
     ~Simulator();
     Simulator(Simulator&&) noexcept;
     Simulator& operator=(Simulator&&) noexcept;
