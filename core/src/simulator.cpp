@@ -51,6 +51,21 @@ struct Simulator<S>::Impl {
 
     std::size_t n() const { return u.size(); }
 
+    // body(i) for every dof / vertex, in fixed blocks on the executor: the
+    // per-step O(n) work never runs as a serial section.
+    template <class Body>
+    void each(Body&& body) const {
+        for_blocks(*exec, n(), [&](std::size_t lo, std::size_t hi) {
+            for (std::size_t i = lo; i < hi; ++i) body(i);
+        });
+    }
+    template <class Body>
+    void each_vertex(Body&& body) const {
+        for_blocks(*exec, mass.size(), [&](std::size_t lo, std::size_t hi) {
+            for (std::size_t i = lo; i < hi; ++i) body(i);
+        });
+    }
+
     Impl(Scene s, std::shared_ptr<const Executor> e, OperatorFactory<S> make_op)
         : scene(std::move(s)), exec(std::move(e)), factory(std::move(make_op)) {
         scene.validate();
@@ -91,7 +106,7 @@ struct Simulator<S>::Impl {
 
     // External load h = load (M g + f_ext).
     void external(double load) {
-        for (std::size_t i = 0; i < n(); ++i) h[i] = load * (mass[i / 3] * scene.gravity[i % 3] + double(fext[i]));
+        each([&](std::size_t i) { h[i] = load * (mass[i / 3] * scene.gravity[i % 3] + double(fext[i])); });
     }
 
     // Fraction of the prescribed targets reached at time t.
@@ -106,19 +121,19 @@ struct Simulator<S>::Impl {
         } else {
             xs.resize(n());
             ys.resize(n());
-            for (std::size_t i = 0; i < n(); ++i) xs[i] = S(in[i]);
+            each([&](std::size_t i) { xs[i] = S(in[i]); });
             K.multiply(xs.data(), ys.data());
-            for (std::size_t i = 0; i < n(); ++i) out[i] = double(ys[i]);
+            each([&](std::size_t i) { out[i] = double(ys[i]); });
         }
     }
 
     // A = c_m M + c_k K + c_b K0.
     void apply_system(double c_m, double c_k, double c_b, const double* in, double* out) {
         multiply(*op, in, out);
-        for (std::size_t i = 0; i < n(); ++i) out[i] = c_m * mass[i / 3] * in[i] + c_k * out[i];
+        each([&](std::size_t i) { out[i] = c_m * mass[i / 3] * in[i] + c_k * out[i]; });
         if (c_b != 0) {
             multiply(*op_damp, in, Ax.data());
-            for (std::size_t i = 0; i < n(); ++i) out[i] += c_b * Ax[i];
+            each([&](std::size_t i) { out[i] += c_b * Ax[i]; });
         }
     }
 
@@ -132,7 +147,7 @@ struct Simulator<S>::Impl {
             D0.resize(D.size());
             op_damp->diagonal_blocks(D0.data());
         }
-        for (std::size_t vtx = 0; vtx < mass.size(); ++vtx) {
+        each_vertex([&](std::size_t vtx) {
             Eigen::Matrix3d B;
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j)
@@ -149,7 +164,7 @@ struct Simulator<S>::Impl {
             }
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j) Dinv[9 * vtx + 3 * i + j] = inv(i, j);
-        }
+        });
     }
 
     // Solves A x = b on the free dofs; x holds the constrained values and a
@@ -208,11 +223,11 @@ struct Simulator<S>::Impl {
         res = conjugate_gradient(
             *exec, n(), free_dof.data(), [&](const double* in, double* out) { apply_system(c_m, c_k, c_b, in, out); },
             [&](const double* r, double* z) {
-                for (std::size_t vtx = 0; vtx < mass.size(); ++vtx) {
+                each_vertex([&](std::size_t vtx) {
                     const double* M = &Dinv[9 * vtx];
                     const double* rv = &r[3 * vtx];
                     for (int i = 0; i < 3; ++i) z[3 * vtx + i] = M[3 * i] * rv[0] + M[3 * i + 1] * rv[1] + M[3 * i + 2] * rv[2];
-                }
+                });
             },
             b.data(), x.data(), tolerance, scene.solver.cg_max_iterations, scene.solver.cg_fixed_iterations, cg);
         stats.solve_ms += ms_since(t0);
@@ -228,12 +243,24 @@ struct Simulator<S>::Impl {
     }
 
     void check_finite(long step_no) const {
-        for (std::size_t i = 0; i < n(); ++i)
-            if (!std::isfinite(double(u[i])) || !std::isfinite(double(v[i])))
-                throw StepFailure{"step " + std::to_string(step_no) + ": non-finite " +
+        // First non-finite dof, found block-parallel.
+        const std::size_t chunks = (n() + kVectorChunk - 1) / kVectorChunk;
+        std::vector<std::size_t> first(chunks, n());
+        for_blocks(*exec, n(), [&](std::size_t lo, std::size_t hi) {
+            for (std::size_t i = lo; i < hi; ++i)
+                if (!std::isfinite(double(u[i])) || !std::isfinite(double(v[i]))) {
+                    first[lo / kVectorChunk] = i;
+                    break;
+                }
+        });
+        const std::size_t bad = *std::min_element(first.begin(), first.end());
+        if (bad < n()) {
+            const std::size_t i = bad;
+            throw StepFailure{"step " + std::to_string(step_no) + ": non-finite " +
                                       (std::isfinite(double(u[i])) ? "velocity" : "displacement") + " at vertex " +
                                       std::to_string(i / 3) + " (unstable: reduce dt or use an implicit integrator)",
                                   index_t(i / 3)};
+        }
     }
 
     // Constrained velocities that reach the targets at time t_end.
@@ -250,31 +277,31 @@ struct Simulator<S>::Impl {
         forces(false);
         external(1.0);
         const double damp = 1 + T * scene.rayleigh_alpha;
-        for (std::size_t i = 0; i < n(); ++i) x[i] = (double(v[i]) + T * (h[i] - double(f[i])) / mass[i / 3]) / damp;
+        each([&](std::size_t i) { x[i] = (double(v[i]) + T * (h[i] - double(f[i])) / mass[i / 3]) / damp; });
         constrained_velocities(T, time + T, x.data());
-        for (std::size_t i = 0; i < n(); ++i) {
+        each([&](std::size_t i) {
             v[i] = S(x[i]);
             u[i] += S(T * x[i]);
-        }
+        });
     }
 
     void semi_implicit_step(double T) {
         forces(false);
         external(1.0);
         const double c_m = 1 + T * scene.rayleigh_alpha, c_k = T * scene.rayleigh_beta + T * T;
-        for (std::size_t i = 0; i < n(); ++i) {
+        each([&](std::size_t i) {
             b[i] = mass[i / 3] * double(v[i]) + T * (h[i] - double(f[i]));
             x[i] = double(v[i]);  // warm start
-        }
+        });
         constrained_velocities(T, time + T, x.data());
         const CgResult res = solve(c_m, c_k, 0.0, scene.solver.cg_tolerance, scene.solver.definite_stiffness);
         stats.residual = res.residual;
         if (!std::isfinite(res.residual))
             throw StepFailure{"step " + std::to_string(step + 1) + ": linear solve failed (non-finite residual)", -1};
-        for (std::size_t i = 0; i < n(); ++i) {
+        each([&](std::size_t i) {
             v[i] = S(x[i]);
             u[i] += S(T * x[i]);
-        }
+        });
     }
 
     // Newton on the incremental potential. Static when T == 0: then the
@@ -394,7 +421,13 @@ struct Simulator<S>::Impl {
     }
 
     void advance(double T, int depth) {
-        const std::vector<S> u_save = u, v_save = v;
+        // The state is saved only when a failed step may be retried.
+        const bool may_retry = depth < scene.solver.max_step_halvings;
+        std::vector<S> u_save, v_save;
+        if (may_retry) {
+            u_save = u;
+            v_save = v;
+        }
         try {
             switch (scene.integrator) {
                 case Integrator::Explicit: explicit_step(T); break;
@@ -404,7 +437,7 @@ struct Simulator<S>::Impl {
             check_finite(step + 1);
             time += T;
         } catch (const StepFailure& failure) {
-            if (depth >= scene.solver.max_step_halvings) throw;
+            if (!may_retry) throw;
             u = u_save;
             v = v_save;
             ++stats.halvings;
