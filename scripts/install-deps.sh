@@ -12,6 +12,7 @@ packages=(
   libbenchmark-dev    # benchmarks
   libcli11-dev        # command-line parsing
   nlohmann-json3-dev  # scene files
+  python3-getfem      # tests: GetFEM reference for `edgefem static` (system python3)
   libfmt-dev
 )
 
