@@ -1,13 +1,16 @@
 // `edgefem bench MESH --kernel K`: times one kernel on the twist
-// configuration, one steady_clock reading per call.
+// configuration, or one semi-implicit time step, one steady_clock reading per
+// call.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 
 #include "common.hpp"
 #include "edgefem/core/deformations.hpp"
+#include "edgefem/core/simulator.hpp"
 
 namespace edgefem::cli {
 
@@ -18,6 +21,7 @@ struct BenchOptions {
     ModelOptions model;
     std::string kernel;
     double seconds = 1.0;
+    int cg_iters = 0;  // step: > 0 runs exactly this many CG iterations
 };
 
 const std::map<std::string, Kernel> kKernels = {{"force", Kernel::Force},
@@ -25,39 +29,34 @@ const std::map<std::string, Kernel> kKernels = {{"force", Kernel::Force},
                                                 {"force+stiffness", Kernel::ForceStiffness},
                                                 {"kx", Kernel::Kx}};
 
-void run_bench(const BenchOptions& opts) {
-    opts.model.validate();
-    const Kernel kernel = kKernels.at(opts.kernel);
-    const LoadedMesh lm = load_mesh(opts.mesh);
-    const Mesh& mesh = lm.mesh;
-    for (const auto& w : load_warnings(lm)) std::fprintf(stderr, "edgefem: warning: %s\n", w.c_str());
-
-    auto eval = make_evaluator(mesh, opts.model);
-    eval->set_displacement(deformation_displacement(mesh, Deformation::Twist));
-    // kx multiplies a generic (non-smooth) vector.
-    eval->prepare(kernel, deformation_displacement(mesh, Deformation::Random));
-
+// Calls `call` for a warm-up (caches, page faults, clock ramp-up: 5% of the
+// budget, at least one call), then until `seconds` have passed (at least 5
+// calls); returns the timed calls' durations in ns, sorted.
+template <class Call>
+std::vector<double> time_calls(double seconds, Call call) {
     using clock = std::chrono::steady_clock;
-    const auto budget = std::chrono::duration<double>(opts.seconds);
-    // Warm-up (caches, page faults, clock ramp-up): 5% of the budget, at least one call.
+    const auto budget = std::chrono::duration<double>(seconds);
     for (const auto w0 = clock::now(); ;) {
-        eval->run(kernel);
-        eval->consume();
+        call();
         if (clock::now() - w0 >= 0.05 * budget) break;
     }
     std::vector<double> ns;
     for (const auto start = clock::now(); ns.size() < 5 || clock::now() - start < budget;) {
         const auto t0 = clock::now();
-        eval->run(kernel);
-        eval->consume();
+        call();
         const auto t1 = clock::now();
         ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
     }
     std::sort(ns.begin(), ns.end());
-    const std::size_t n = ns.size();
-    const double median = n % 2 ? ns[n / 2] : 0.5 * (ns[n / 2 - 1] + ns[n / 2]);
-    const double tets = mesh.num_tets();
+    return ns;
+}
 
+double median_of_sorted(const std::vector<double>& v) {
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void print_header(const BenchOptions& opts, const Mesh& mesh) {
     print_kv("mesh", opts.mesh.path);
     print_kv("vertices", mesh.num_vertices());
     print_kv("tets", mesh.num_tets());
@@ -65,7 +64,78 @@ void run_bench(const BenchOptions& opts) {
     print_kv("method", opts.model.method);
     print_kv("model", opts.model.model);
     print_kv("precision", opts.model.precision);
-    print_kv("calls", n);
+}
+
+// One semi-implicit step (dt = 1 ms) of the mesh standing on its lowest 1%
+// along z under gravity -z; the state moves on from call to call.
+template <class S>
+void bench_step(const BenchOptions& opts, Mesh mesh) {
+    Scene scene;
+    double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+    for (index_t v = 0; v < mesh.num_vertices(); ++v) {
+        zmin = std::min(zmin, mesh.X[3 * std::size_t(v) + 2]);
+        zmax = std::max(zmax, mesh.X[3 * std::size_t(v) + 2]);
+    }
+    for (index_t v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.X[3 * std::size_t(v) + 2] <= zmin + 0.01 * (zmax - zmin)) scene.fixed.push_back(v);
+    scene.mesh = std::move(mesh);
+    scene.materials = opts.model.material;
+    scene.model = opts.model.kind();
+    scene.method = opts.model.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
+    scene.gravity = {0, 0, -9.81};
+    scene.integrator = Integrator::SemiImplicit;
+    scene.dt = 1e-3;
+    scene.solver.cg_tolerance = 1e-6;
+    scene.solver.cg_fixed_iterations = opts.cg_iters;
+    Simulator<S> sim(std::move(scene));
+
+    std::vector<int> iterations;  // of every call, warm-up included
+    const std::vector<double> ns = time_calls(opts.seconds, [&] { iterations.push_back(sim.step().solver_iterations); });
+    iterations.erase(iterations.begin(), iterations.end() - std::ptrdiff_t(ns.size()));  // the timed calls'
+    double mean_iterations = 0;
+    for (int i : iterations) mean_iterations += i;
+    mean_iterations /= double(iterations.size());
+    const double median = median_of_sorted(ns), tets = sim.scene().mesh.num_tets();
+
+    print_header(opts, sim.scene().mesh);
+    print_kv("fixed_vertices", sim.scene().fixed.size());
+    print_kv("steps", ns.size());
+    print_kv("median_ms_per_step", fmt(median * 1e-6, 6));
+    print_kv("min_ms_per_step", fmt(ns.front() * 1e-6, 6));
+    print_kv("median_ns_per_tet", fmt(median / tets, 6));
+    print_kv("cg_iterations", fmt(mean_iterations, 6));
+    print_kv("cg_iterations_max", *std::max_element(iterations.begin(), iterations.end()));
+}
+
+void run_bench(const BenchOptions& opts) {
+    opts.model.validate();
+    if (opts.cg_iters > 0 && opts.kernel != "step") throw InvalidArgument("--cg-iters applies only to --kernel step");
+    LoadedMesh lm = load_mesh(opts.mesh);
+    for (const auto& w : load_warnings(lm)) std::fprintf(stderr, "edgefem: warning: %s\n", w.c_str());
+    if (opts.kernel == "step") {
+        if (opts.model.precision_kind() == Precision::Float)
+            bench_step<float>(opts, std::move(lm.mesh));
+        else
+            bench_step<double>(opts, std::move(lm.mesh));
+        return;
+    }
+    const Kernel kernel = kKernels.at(opts.kernel);
+    const Mesh& mesh = lm.mesh;
+
+    auto eval = make_evaluator(mesh, opts.model);
+    eval->set_displacement(deformation_displacement(mesh, Deformation::Twist));
+    // kx multiplies a generic (non-smooth) vector.
+    eval->prepare(kernel, deformation_displacement(mesh, Deformation::Random));
+
+    const std::vector<double> ns = time_calls(opts.seconds, [&] {
+        eval->run(kernel);
+        eval->consume();
+    });
+    const double median = median_of_sorted(ns);
+    const double tets = mesh.num_tets();
+
+    print_header(opts, mesh);
+    print_kv("calls", ns.size());
     print_kv("median_ms", fmt(median * 1e-6, 6));
     print_kv("min_ms", fmt(ns.front() * 1e-6, 6));
     print_kv("median_ns_per_tet", fmt(median / tets, 6));
@@ -78,16 +148,21 @@ void add_bench_command(CLI::App& app) {
     auto opts = std::make_shared<BenchOptions>();
     auto* cmd = app.add_subcommand(
         "bench",
-        "Time one kernel on the twist configuration (single thread): a warm-up, then calls until --seconds "
-        "have passed (at least 5); reports the median and minimum per call and per tet");
+        "Time one kernel on the twist configuration, or one time step (single thread): a warm-up, then "
+        "calls until --seconds have passed (at least 5); reports the median and minimum per call and per tet");
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/false);
     cmd->add_option("--kernel", opts->kernel,
                     "force: forces only (no energy); stiffness: K from a previous force call's state (edge) or "
                     "the per-tet 12x12 blocks (tet); force+stiffness: both; kx: y = K x with K precomputed "
-                    "(edge: per-edge blocks, tet: stored per-tet blocks)")
+                    "(edge: per-edge blocks, tet: stored per-tet blocks); step: one semi-implicit step "
+                    "(dt = 1 ms, gravity -z, the lowest 1% of the mesh along z fixed, CG to 1e-6 or "
+                    "--cg-iters iterations), successive steps from the moving state")
         ->required()
-        ->check(CLI::IsMember({"force", "stiffness", "force+stiffness", "kx"}));
+        ->check(CLI::IsMember({"force", "stiffness", "force+stiffness", "kx", "step"}));
+    cmd->add_option("--cg-iters", opts->cg_iters,
+                    "step: run exactly N warm-started CG iterations per step instead of solving to 1e-6")
+        ->check(CLI::PositiveNumber);
     cmd->add_option("--seconds", opts->seconds, "Time budget of the timed calls")
         ->check(CLI::Validator(
             [](std::string& s) {

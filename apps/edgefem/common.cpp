@@ -30,36 +30,9 @@ void add_mesh_options(CLI::App& cmd, MeshOptions& opts) {
     cmd.add_flag("--compact", opts.compact, "Remove vertices that no tet uses");
 }
 
-namespace {
-
-constexpr const char* kBoxPrefix = "box:";
-
-// "box:NXxNYxNZ" -> make_box; the whole spec must parse.
-Mesh make_box_from_spec(const std::string& spec) {
-    const auto bad = [&] {
-        return InvalidArgument("bad box mesh '" + spec + "': expected box:NXxNYxNZ with positive integers, e.g. box:10x5x4");
-    };
-    index_t n[3];
-    const char* p = spec.data() + std::strlen(kBoxPrefix);
-    const char* end = spec.data() + spec.size();
-    for (int i = 0; i < 3; ++i) {
-        const auto [next, ec] = std::from_chars(p, end, n[i]);
-        if (ec != std::errc() || n[i] <= 0) throw bad();
-        p = next;
-        if (i < 2) {
-            if (p == end || (*p != 'x' && *p != 'X')) throw bad();
-            ++p;
-        }
-    }
-    if (p != end) throw bad();
-    return make_box(n[0], n[1], n[2]);
-}
-
-}  // namespace
-
 LoadedMesh load_mesh(const MeshOptions& opts) {
     LoadedMesh m;
-    if (opts.path.rfind(kBoxPrefix, 0) == 0)
+    if (is_box_spec(opts.path))
         m.mesh = make_box_from_spec(opts.path);
     else
         m.mesh = read_mesh(opts.path, MeshFormat::Auto, &m.read);

@@ -1,5 +1,6 @@
 // edgefem: command-line front end of the edgefem library. Every error is one
-// line "edgefem: error: <message>" on stderr and exit code 2.
+// line "edgefem: error: <message>" on stderr and exit code 2, or 3 when a
+// simulation fails (a SimulationError: unstable step, failed solve).
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -7,17 +8,20 @@
 #include <CLI/CLI.hpp>
 
 #include "common.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "sim_common.hpp"
 
 namespace {
 
 constexpr int kErrorExit = 2;
+constexpr int kSimulationFailedExit = 3;
 
-int fail(std::string message) {
+int fail(std::string message, int code = kErrorExit) {
     // One line, whatever the message holds.
     for (char& c : message)
         if (c == '\n' || c == '\r') c = ' ';
     std::fprintf(stderr, "edgefem: error: %s\n", message.c_str());
-    return kErrorExit;
+    return code;
 }
 
 }  // namespace
@@ -35,16 +39,20 @@ int main(int argc, char** argv) {
         "  edgefem info box:10x5x4\n"
         "  edgefem forces box:10x5x4 --young 1e5 --poisson 0.3 --deform twist --out twist\n"
         "  edgefem bench box:10x5x4 --kernel force --method tet\n"
-        "Errors print one line 'edgefem: error: ...' to stderr and exit with code 2.");
+        "  edgefem simulate examples/scenes/cantilever.json --out cantilever-out\n"
+        "Errors print one line 'edgefem: error: ...' to stderr. Exit codes: 0 ok, 2 bad input,\n"
+        "3 simulation failed (unstable step or failed solve; the message names the step and vertex).");
     edgefem::cli::add_info_command(app);
     edgefem::cli::add_forces_command(app);
     edgefem::cli::add_bench_command(app);
+    edgefem::cli::add_simulate_command(app);
+    edgefem::cli::add_static_command(app);
     // CLI11 would report a mistyped subcommand as "A subcommand is required".
     if (argc > 1 && argv[1][0] != '-') {
         bool known = false;
         for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
             known = known || sub->get_name() == argv[1];
-        if (!known) return fail(std::string("unknown subcommand '") + argv[1] + "' (expected info, forces or bench)");
+        if (!known) return fail(std::string("unknown subcommand '") + argv[1] + "' (expected info, forces, bench, simulate or static)");
     }
     try {
         app.parse(argc, argv);  // runs the selected subcommand's callback
@@ -52,6 +60,8 @@ int main(int argc, char** argv) {
         return app.exit(e);  // --help, --version
     } catch (const CLI::ParseError& e) {
         return fail(e.what());
+    } catch (const edgefem::SimulationError& e) {
+        return fail(std::string("simulation failed: ") + e.what(), kSimulationFailedExit);
     } catch (const std::exception& e) {
         return fail(e.what());
     }

@@ -1,6 +1,7 @@
 #include "edgefem/core/make_box.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -59,6 +60,29 @@ Mesh make_box(index_t nx, index_t ny, index_t nz, double cell) {
                     mesh.tets.insert(mesh.tets.end(), t, t + 4);
                 }
     return mesh;
+}
+
+bool is_box_spec(const std::string& spec) { return spec.rfind("box:", 0) == 0; }
+
+Mesh make_box_from_spec(const std::string& spec) {
+    const auto bad = [&] {
+        return InvalidArgument("bad box mesh '" + spec + "': expected box:NXxNYxNZ with positive integers, e.g. box:10x5x4");
+    };
+    if (!is_box_spec(spec)) throw bad();
+    index_t n[3];
+    const char* p = spec.data() + 4;
+    const char* end = spec.data() + spec.size();
+    for (int i = 0; i < 3; ++i) {
+        const auto [next, ec] = std::from_chars(p, end, n[i]);
+        if (ec != std::errc() || n[i] <= 0) throw bad();
+        p = next;
+        if (i < 2) {
+            if (p == end || (*p != 'x' && *p != 'X')) throw bad();
+            ++p;
+        }
+    }
+    if (p != end) throw bad();
+    return make_box(n[0], n[1], n[2]);
 }
 
 Mesh make_box_of_size(double target_tets) {

@@ -3,6 +3,8 @@
 // oriented. make_box(10, 5, 4) is the paper's 1,200-tet box.
 #pragma once
 
+#include <string>
+
 #include "edgefem/core/mesh.hpp"
 
 namespace edgefem {
@@ -11,6 +13,12 @@ namespace edgefem {
 // i + (NX+1) (j + (NY+1) k). Throws InvalidArgument for non-positive sizes or
 // more than 2^31-1 tets or vertices.
 Mesh make_box(index_t nx, index_t ny, index_t nz, double cell = 0.01);
+
+// "box:NXxNYxNZ" (cubes of 0.01 m), the spelling the CLI and scene files
+// accept for a generated mesh. is_box_spec tells whether a string uses it;
+// make_box_from_spec throws InvalidArgument unless the whole spec parses.
+bool is_box_spec(const std::string& spec);
+Mesh make_box_from_spec(const std::string& spec);
 
 // A box of about `target_tets` tets with the paper box's 5:2.5:2 aspect
 // (cells of 0.1 / nx m); used as a stand-in when a named mesh is absent.

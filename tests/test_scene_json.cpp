@@ -1,0 +1,377 @@
+// Scene files (docs/scenes.md): every key, the defaults, relative paths, and
+// an error naming the key for every kind of bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <initializer_list>
+#include <string>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/scene_json.hpp"
+#include "io_test_util.hpp"
+
+namespace edgefem::test {
+namespace {
+
+SceneFile parse(const std::string& text, const std::string& base_dir = "") {
+    return parse_scene(text, base_dir, "scene.json");
+}
+
+// Expects parse(text) to throw E whose message contains every part.
+template <class E = InvalidArgument>
+std::string expect_error(const std::string& text, std::initializer_list<std::string> parts,
+                         const std::string& base_dir = "") {
+    try {
+        parse(text, base_dir);
+    } catch (const E& e) {
+        const std::string msg = e.what();
+        for (const auto& part : parts) EXPECT_NE(msg.find(part), std::string::npos) << "message lacks '" << part << "': " << msg;
+        return msg;
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "wrong exception type: " << e.what();
+        return {};
+    }
+    ADD_FAILURE() << "no error for: " << text;
+    return {};
+}
+
+// box:2x2x2 has 27 vertices, index i + 3 (j + 3 k), coordinates -0.01, 0, 0.01.
+constexpr const char* kBox = R"("mesh": "box:2x2x2")";
+
+std::string scene(const std::string& rest) { return std::string("{") + kBox + (rest.empty() ? "" : ", " + rest) + "}"; }
+
+TEST(SceneJson, Defaults) {
+    const SceneFile sf = parse(scene(""));
+    const Scene& s = sf.scene;
+    const Scene d;
+    EXPECT_EQ(s.mesh.num_tets(), 48);
+    EXPECT_EQ(s.materials.fallback.young, d.materials.fallback.young);
+    EXPECT_EQ(s.materials.fallback.poisson, d.materials.fallback.poisson);
+    EXPECT_EQ(s.materials.fallback.density, d.materials.fallback.density);
+    EXPECT_TRUE(s.materials.by_region.empty());
+    EXPECT_EQ(s.model, ModelKind::FE);
+    EXPECT_EQ(s.method, Method::Edge);
+    EXPECT_EQ(s.gravity, d.gravity);
+    EXPECT_EQ(s.rayleigh_alpha, 0);
+    EXPECT_EQ(s.rayleigh_beta, 0);
+    EXPECT_TRUE(s.fixed.empty());
+    EXPECT_TRUE(s.prescribed.empty());
+    EXPECT_EQ(s.prescribed_steps, 1);
+    EXPECT_EQ(s.integrator, Integrator::SemiImplicit);
+    EXPECT_EQ(s.dt, d.dt);
+    EXPECT_EQ(s.steps, d.steps);
+    EXPECT_EQ(s.solver.linear_solver, d.solver.linear_solver);
+    EXPECT_EQ(s.solver.cg_tolerance, d.solver.cg_tolerance);
+    EXPECT_EQ(s.solver.cg_max_iterations, d.solver.cg_max_iterations);
+    EXPECT_EQ(s.solver.cg_fixed_iterations, d.solver.cg_fixed_iterations);
+    EXPECT_EQ(s.solver.definite_stiffness, d.solver.definite_stiffness);
+    EXPECT_EQ(s.solver.newton_tolerance, d.solver.newton_tolerance);
+    EXPECT_EQ(s.solver.newton_max_iterations, d.solver.newton_max_iterations);
+    EXPECT_EQ(s.solver.load_steps, d.solver.load_steps);
+    EXPECT_EQ(s.solver.max_step_halvings, d.solver.max_step_halvings);
+    EXPECT_EQ(sf.output.dir, "edgefem-out");
+    EXPECT_EQ(sf.output.every, 10);
+    EXPECT_TRUE(sf.output.vtu);
+    EXPECT_EQ(sf.path, "scene.json");
+}
+
+TEST(SceneJson, EveryKey) {
+    TempDir dir("scene_every_key");
+    spit(dir.file("fix.txt"), "# fixed\n0\n\n2  # a comment\n");
+    spit(dir.file("target.txt"), "26 0.02 0.02 0.02\n");
+    // Comments are allowed in scene files; integers may be written as 1e3.
+    const SceneFile sf = parse(R"({
+        // the lot
+        "mesh": {"box": {"cells": [2, 2, 2], "cell": 0.02}},
+        "mesh_options": {"fix_orientation": true, "compact": true},
+        "material": {"young": 2e5, "poisson": 0.25, "density": 900},
+        "regions": {"0": {"young": 3e5}},
+        "model": "sn",
+        "method": "edge",
+        "gravity": [1, 2, -9.81],
+        "damping": {"alpha": 0.1, "beta": 0.01},
+        "fixed": [{"file": "fix.txt"}, {"vertices": [1, 2]}, {"box": {"min": [-1, -1, -1], "max": [-0.02, -0.02, 1]}}],
+        "prescribed": {"file": "target.txt", "steps": 7},
+        "integrator": "implicit",
+        "dt": 0.002,
+        "steps": 1e3,
+        "solver": {"linear": "direct", "cg_tolerance": 1e-8, "cg_max_iterations": 77, "cg_fixed_iterations": 5,
+                   "definite_stiffness": true, "newton_tolerance": 1e-9, "newton_max_iterations": 12,
+                   "load_steps": 3, "max_step_halvings": 2},
+        "output": {"dir": "out/here", "every": 4, "vtu": false}
+    })",
+                               dir.path());
+    const Scene& s = sf.scene;
+    EXPECT_EQ(s.mesh.num_tets(), 48);
+    EXPECT_DOUBLE_EQ(s.mesh.X[0], -0.02);  // cell 0.02
+    EXPECT_EQ(s.materials.fallback.young, 2e5);
+    EXPECT_EQ(s.materials.fallback.poisson, 0.25);
+    EXPECT_EQ(s.materials.fallback.density, 900);
+    ASSERT_EQ(s.materials.by_region.count(0), 1u);
+    EXPECT_EQ(s.materials.by_region.at(0).young, 3e5);
+    EXPECT_EQ(s.materials.by_region.at(0).poisson, 0.25);  // inherited from "material"
+    EXPECT_EQ(s.materials.by_region.at(0).density, 900);
+    EXPECT_EQ(s.model, ModelKind::SN);
+    EXPECT_EQ(s.method, Method::Edge);
+    EXPECT_EQ(s.gravity, (std::array<double, 3>{1, 2, -9.81}));
+    EXPECT_EQ(s.rayleigh_alpha, 0.1);
+    EXPECT_EQ(s.rayleigh_beta, 0.01);
+    // file {0, 2} + vertices {1, 2} + box (x, y at the minimum: i = j = 0, k = 0..2 -> 0, 9, 18), united.
+    EXPECT_EQ(s.fixed, (std::vector<index_t>{0, 1, 2, 9, 18}));
+    ASSERT_EQ(s.prescribed.size(), 1u);
+    EXPECT_EQ(s.prescribed[0].vertex, 26);
+    EXPECT_EQ(s.prescribed[0].target, (std::array<double, 3>{0.02, 0.02, 0.02}));
+    EXPECT_EQ(s.prescribed_steps, 7);
+    EXPECT_EQ(s.integrator, Integrator::Implicit);
+    EXPECT_EQ(s.dt, 0.002);
+    EXPECT_EQ(s.steps, 1000);
+    EXPECT_EQ(s.solver.linear_solver, LinearSolver::Direct);
+    EXPECT_EQ(s.solver.cg_tolerance, 1e-8);
+    EXPECT_EQ(s.solver.cg_max_iterations, 77);
+    EXPECT_EQ(s.solver.cg_fixed_iterations, 5);
+    EXPECT_TRUE(s.solver.definite_stiffness);
+    EXPECT_EQ(s.solver.newton_tolerance, 1e-9);
+    EXPECT_EQ(s.solver.newton_max_iterations, 12);
+    EXPECT_EQ(s.solver.load_steps, 3);
+    EXPECT_EQ(s.solver.max_step_halvings, 2);
+    EXPECT_EQ(sf.output.dir, "out/here");
+    EXPECT_EQ(sf.output.every, 4);
+    EXPECT_FALSE(sf.output.vtu);
+}
+
+TEST(SceneJson, OtherSpellings) {
+    const SceneFile a = parse(R"({"mesh": "box:3x2x1", "method": "tet", "integrator": "explicit",
+                                  "fixed": {"vertices": [0]}})");
+    EXPECT_EQ(a.scene.mesh.num_tets(), 36);
+    EXPECT_DOUBLE_EQ(a.scene.mesh.X[0], -0.015);  // box: cells are 0.01 m
+    EXPECT_EQ(a.scene.method, Method::Tet);
+    EXPECT_EQ(a.scene.integrator, Integrator::Explicit);
+    EXPECT_EQ(a.scene.fixed, (std::vector<index_t>{0}));
+    // A box without "min" is unbounded below; bounds are inclusive.
+    const SceneFile b = parse(scene(R"("fixed": {"box": {"max": [-0.01, 0.0, 1]}})"));
+    EXPECT_EQ(b.scene.fixed, (std::vector<index_t>{0, 3, 9, 12, 18, 21}));
+    const SceneFile c = parse(scene(R"("integrator": "semi-implicit", "solver": {"linear": "cg"})"));
+    EXPECT_EQ(c.scene.solver.linear_solver, LinearSolver::CG);
+}
+
+TEST(SceneJson, RelativePathsResolveAgainstTheSceneFolder) {
+    TempDir dir("scene_paths");
+    std::filesystem::create_directories(dir.file("meshes"));
+    std::filesystem::create_directories(dir.file("scenes"));
+    for (const char* f : {"small0.node", "small0.ele"})
+        std::filesystem::copy_file(data_file(f), dir.file(std::string("meshes/") + f));
+    spit(dir.file("scenes/fix.txt"), "0\n1\n2\n");
+    spit(dir.file("scenes/target.txt"), "# index x y z\n\n3 0 0 0.12\n");
+    const std::string path = dir.file("scenes/s.json");
+    spit(path, R"({"mesh": "../meshes/small0.node", "fixed": {"file": "fix.txt"},
+                   "prescribed": {"file": "target.txt"}, "output": {"dir": "out"}})");
+    const SceneFile sf = load_scene(path);
+    EXPECT_EQ(sf.path, path);
+    EXPECT_EQ(sf.scene.mesh.num_tets(), 3);
+    EXPECT_EQ(sf.scene.fixed, (std::vector<index_t>{0, 1, 2}));
+    ASSERT_EQ(sf.scene.prescribed.size(), 1u);
+    EXPECT_EQ(sf.scene.prescribed[0].vertex, 3);
+    EXPECT_EQ(sf.output.dir, "out");  // relative to the current directory, not resolved
+    // parse_scene resolves against the folder it is given.
+    EXPECT_EQ(parse(R"({"mesh": "meshes/small0.node"})", dir.path()).scene.mesh.num_tets(), 3);
+    // An absolute path is used as it is.
+    EXPECT_EQ(parse(R"({"mesh": ")" + dir.file("meshes/small0") + R"("})", "/nonexistent").scene.mesh.num_tets(), 3);
+}
+
+TEST(SceneJson, RegionMaterials) {
+    // small1 has regions 1 and 2.
+    const SceneFile sf = parse(R"({"mesh": ")" + data_file("small1") + R"(",
+        "material": {"young": 1e5}, "regions": {"2": {"young": 4e5, "density": 2000}, "5": {"young": 1}}})");
+    const Materials& m = sf.scene.materials;
+    EXPECT_EQ(m.of(1).young, 1e5);
+    EXPECT_EQ(m.of(2).young, 4e5);
+    EXPECT_EQ(m.of(2).density, 2000);
+    // Region 5 is in no tet: a warning, not an error.
+    EXPECT_TRUE(std::any_of(sf.warnings.begin(), sf.warnings.end(),
+                            [](const std::string& w) { return w.find("regions.5") != std::string::npos; }));
+}
+
+TEST(SceneJson, CompactionRenumbersSelectedVertices) {
+    // Vertex 5 is unused; with "compact" it is removed and vertex 6 becomes 5.
+    const std::string mesh = R"("mesh": ")" + data_file("bad/unreferenced.node") + R"(")";
+    const SceneFile sf = parse("{" + mesh + R"(, "mesh_options": {"compact": true}, "fixed": {"vertices": [0, 5, 6]}})");
+    EXPECT_EQ(sf.scene.mesh.num_vertices(), 6);
+    EXPECT_EQ(sf.scene.fixed, (std::vector<index_t>{0, 5}));
+    expect_error("{" + mesh + R"(, "mesh_options": {"compact": true}, "fixed": {"vertices": [5]}})",
+                 {"\"fixed\"", "selects no vertex"});
+    // Without it the vertex is kept, with a warning.
+    EXPECT_FALSE(parse("{" + mesh + "}").warnings.empty());
+}
+
+TEST(SceneJson, DefaultScene) {
+    const Scene s = default_scene();
+    EXPECT_EQ(s.mesh.num_tets(), 19200);
+    EXPECT_EQ(s.fixed.size(), 11u * 9u);  // the x = min face of 40 x 10 x 8 cells
+    for (index_t v : s.fixed) EXPECT_DOUBLE_EQ(s.mesh.X[3 * std::size_t(v)], -0.1);
+    EXPECT_EQ(s.gravity, (std::array<double, 3>{0, 0, -9.81}));
+    EXPECT_EQ(s.materials.fallback.young, 1e6);  // docs/scenes.md: soft rubber
+    EXPECT_EQ(s.integrator, Integrator::SemiImplicit);
+    EXPECT_EQ(s.dt, 1e-3);
+    EXPECT_EQ(s.steps, 1000);
+    EXPECT_EQ(s.solver.cg_tolerance, 1e-6);
+    EXPECT_NO_THROW(s.validate());
+    EXPECT_EQ(default_scene_file().output.every, 20);
+}
+
+// docs/scenes.md shows the built-in scene as a scene file; they must agree.
+TEST(SceneJson, DocumentedDefaultSceneMatches) {
+    const SceneFile sf = parse(R"({
+      "mesh": {"box": {"cells": [40, 10, 8], "cell": 0.005}},
+      "material": {"young": 1e5, "poisson": 0.3, "density": 1000},
+      "gravity": [0, 0, -9.81],
+      "fixed": {"box": {"max": [-0.1, 1, 1]}},
+      "integrator": "semi-implicit",
+      "dt": 0.001,
+      "steps": 1000,
+      "solver": {"cg_tolerance": 1e-6},
+      "output": {"every": 20}
+    })");
+    const Scene d = default_scene();
+    EXPECT_EQ(sf.scene.mesh.X, d.mesh.X);
+    EXPECT_EQ(sf.scene.mesh.tets, d.mesh.tets);
+    EXPECT_EQ(sf.scene.fixed, d.fixed);
+    EXPECT_EQ(sf.scene.gravity, d.gravity);
+    EXPECT_EQ(sf.scene.steps, d.steps);
+    EXPECT_EQ(sf.output.every, default_scene_file().output.every);
+}
+
+// The example scenes parse (bunny-drop only where the shared meshes are).
+TEST(SceneJson, Examples) {
+    const std::string dir = test_data_dir() + "/../../examples/scenes/";
+    EXPECT_EQ(load_scene(dir + "cantilever.json").scene.mesh.num_tets(), 4500);
+    const SceneFile twist = load_scene(dir + "twist-bar.json");
+    EXPECT_EQ(twist.scene.prescribed.size(), 25u);
+    EXPECT_EQ(twist.scene.fixed.size(), 25u);
+    if (shared_mesh_prefix("bunny-4k").empty()) {
+        std::printf("shared meshes absent: bunny-drop.json not checked\n");
+    } else {
+        const SceneFile bunny = load_scene(dir + "bunny-drop.json");
+        EXPECT_EQ(bunny.scene.mesh.num_tets(), 4066);
+        EXPECT_FALSE(bunny.scene.fixed.empty());
+    }
+}
+
+// ---- Errors --------------------------------------------------------------
+
+TEST(SceneJsonErrors, ExactMessages) {
+    EXPECT_EQ(expect_error(scene(R"("solver": {"cg_tolerance": -1})"), {}),
+              "scene.json: \"solver.cg_tolerance\": expected a positive number, got -1");
+    EXPECT_EQ(expect_error(scene(R"("fixed": {"vertices": [0, 1, 2, 99999]})"), {}),
+              "scene.json: \"fixed.vertices[3]\": vertex 99999 out of range (mesh has 27 vertices)");
+}
+
+TEST(SceneJsonErrors, UnknownKeys) {
+    expect_error(scene(R"("stepz": 3)"), {"scene.json", "\"stepz\"", "unknown key", "steps"});
+    expect_error(scene(R"("solver": {"cg_tol": 1e-6})"), {"\"solver.cg_tol\"", "unknown key", "cg_tolerance"});
+    expect_error(scene(R"("output": {"directory": "x"})"), {"\"output.directory\""});
+    expect_error(scene(R"("material": {"E": 1})"), {"\"material.E\""});
+    expect_error(scene(R"("damping": {"gamma": 1})"), {"\"damping.gamma\""});
+    expect_error(scene(R"("fixed": [{"vertices": [0]}, {"box": {"lo": [0, 0, 0]}}])"), {"\"fixed[1].box.lo\""});
+    expect_error(scene(R"("prescribed": {"file": "x", "step": 2})"), {"\"prescribed.step\""});
+    expect_error(scene(R"("mesh_options": {"fix": true})"), {"\"mesh_options.fix\""});
+    expect_error(R"({"mesh": {"box": {"cells": [1, 1, 1], "size": 1}}})", {"\"mesh.box.size\""});
+    expect_error(scene(R"("regions": {"0": {"nu": 0.3}})"), {"\"regions.0.nu\""});
+}
+
+TEST(SceneJsonErrors, WrongTypes) {
+    expect_error(scene(R"("dt": "1e-3")"), {"\"dt\"", "number", "\"1e-3\""});
+    expect_error(scene(R"("steps": 2.5)"), {"\"steps\"", "integer", "2.5"});
+    expect_error(scene(R"("steps": "10")"), {"\"steps\""});
+    expect_error(scene(R"("gravity": [0, 0])"), {"\"gravity\"", "3 numbers"});
+    expect_error(scene(R"("gravity": [0, "a", 0])"), {"\"gravity[1]\""});
+    expect_error(scene(R"("solver": {"definite_stiffness": 1})"), {"\"solver.definite_stiffness\"", "true or false"});
+    expect_error(scene(R"("solver": {"cg_max_iterations": 0})"), {"\"solver.cg_max_iterations\"", "positive integer"});
+    expect_error(scene(R"("solver": 3)"), {"\"solver\"", "object"});
+    expect_error(scene(R"("output": {"every": 0})"), {"\"output.every\""});
+    expect_error(scene(R"("output": {"dir": ""})"), {"\"output.dir\""});
+    expect_error(scene(R"("output": {"vtu": "yes"})"), {"\"output.vtu\""});
+    expect_error(scene(R"("material": {"poisson": 0.5})"), {"\"material.poisson\"", "(-1, 0.5)"});
+    expect_error(scene(R"("material": {"young": 0})"), {"\"material.young\""});
+    expect_error(scene(R"("material": {"density": -1})"), {"\"material.density\""});
+    expect_error(scene(R"("damping": {"alpha": -0.1})"), {"\"damping.alpha\"", "non-negative"});
+    expect_error(scene(R"("regions": {"abc": {}})"), {"\"regions.abc\"", "integer"});
+    expect_error(scene(R"("regions": [1])"), {"\"regions\""});
+    expect_error(scene(R"("fixed": {"vertices": [-1]})"), {"\"fixed.vertices[0]\"", "non-negative"});
+    expect_error(scene(R"("fixed": {"vertices": []})"), {"\"fixed.vertices\""});
+    expect_error(scene(R"("fixed": {"vertices": [0], "box": {}})"), {"\"fixed\"", "exactly one"});
+    expect_error(scene(R"("fixed": 3)"), {"\"fixed\""});
+    expect_error(scene(R"("fixed": {"box": {"min": [1, 0, 0], "max": [0, 0, 0]}})"), {"\"fixed.box\"", "exceeds"});
+    expect_error(R"({"mesh": 3})", {"\"mesh\""});
+    expect_error(R"({"mesh": {"box": {"cells": [2, 0, 2]}}})", {"\"mesh.box.cells[1]\"", "positive integer"});
+    expect_error(R"({"mesh": {"box": {"cells": [2, 2, 2], "cell": -1}}})", {"\"mesh.box.cell\""});
+    expect_error(R"({"mesh": "box:3x0x2"})", {"\"mesh\"", "box:NXxNYxNZ"});
+    expect_error(R"([1, 2])", {"scene.json", "object"});
+}
+
+TEST(SceneJsonErrors, BadEnumValues) {
+    expect_error(scene(R"("integrator": "rk4")"), {"\"integrator\"", "\"semi-implicit\"", "\"rk4\""});
+    expect_error(scene(R"("model": "neo-hookean")"), {"\"model\"", "\"fe\", \"sn\""});
+    expect_error(scene(R"("method": "tets")"), {"\"method\""});
+    expect_error(scene(R"("solver": {"linear": "gmres"})"), {"\"solver.linear\"", "\"cg\", \"direct\""});
+}
+
+TEST(SceneJsonErrors, BadValues) {
+    expect_error(scene(R"("dt": -0.001)"), {"\"dt\"", "positive", "-0.001"});
+    expect_error(scene(R"("dt": 0)"), {"\"dt\""});
+    expect_error(scene(R"("steps": -5)"), {"\"steps\""});
+    expect_error(scene(R"("fixed": {"box": {"min": [5, 5, 5], "max": [6, 6, 6]}})"), {"\"fixed\"", "selects no vertex"});
+    expect_error(scene(R"("fixed": [{"vertices": [0]}, {"box": {"min": [5, 5, 5]}}])"), {"\"fixed[1]\"", "selects no vertex"});
+    // Whole-scene checks (Scene::validate) keep the file name.
+    expect_error(scene(R"("model": "sn", "method": "tet")"), {"scene.json", "model"});
+}
+
+TEST(SceneJsonErrors, BadFiles) {
+    TempDir dir("scene_bad_files");
+    spit(dir.file("fix_bad.txt"), "0\n1 x\n");
+    spit(dir.file("fix_range.txt"), "# ok\n0\n27\n");
+    spit(dir.file("fix_empty.txt"), "# nothing\n\n");
+    spit(dir.file("pre_short.txt"), "26 0 0 0\n25 0 0\n");
+    spit(dir.file("pre_nan.txt"), "26 0 nan 0\n");
+    spit(dir.file("pre_text.txt"), "26 0 zero 0\n");
+    spit(dir.file("pre_dup.txt"), "26 0 0 0\n26 1 1 1\n");
+    spit(dir.file("pre_ok.txt"), "0 0 0 0\n");
+    const auto bad = [&](const std::string& rest, std::initializer_list<std::string> parts) {
+        expect_error(scene(rest), parts, dir.path());
+    };
+    bad(R"("fixed": {"file": "fix_bad.txt"})", {"\"fixed.file\"", "fix_bad.txt:2:", "'x'"});
+    bad(R"("fixed": {"file": "fix_range.txt"})", {"\"fixed.file\"", "fix_range.txt:3:", "vertex 27 out of range (mesh has 27 vertices)"});
+    bad(R"("fixed": {"file": "fix_empty.txt"})", {"\"fixed.file\"", "no lines"});
+    bad(R"("fixed": {"file": "no_such.txt"})", {"\"fixed.file\"", "no_such.txt", "cannot open"});
+    bad(R"("prescribed": {"file": "pre_short.txt"})", {"\"prescribed.file\"", "pre_short.txt:2:", "missing coordinate"});
+    bad(R"("prescribed": {"file": "pre_nan.txt"})", {"\"prescribed.file\"", "pre_nan.txt:1:", "non-finite"});
+    bad(R"("prescribed": {"file": "pre_text.txt"})", {"\"prescribed.file\"", "'zero'"});
+    bad(R"("prescribed": {"file": "pre_dup.txt"})", {"\"prescribed.file\"", "pre_dup.txt:2:", "already prescribed on line 1"});
+    bad(R"("prescribed": {"steps": 2})", {"\"prescribed.file\"", "missing"});
+    bad(R"("prescribed": {"file": "pre_ok.txt", "steps": 0})", {"\"prescribed.steps\"", "positive integer"});
+    // A vertex both fixed and prescribed (found by Scene::validate).
+    bad(R"("fixed": {"vertices": [0]}, "prescribed": {"file": "pre_ok.txt"})", {"scene.json", "also fixed"});
+}
+
+TEST(SceneJsonErrors, Mesh) {
+    expect_error(R"({"dt": 0.1})", {"\"mesh\"", "required"});
+    expect_error<MeshError>(R"({"mesh": "/nonexistent/bunny.node"})", {"scene.json", "\"mesh\"", "bunny.node"});
+    expect_error<MeshError>(R"({"mesh": ")" + data_file("bad/inverted") + R"("})", {"\"mesh\"", "inverted.ele"});
+    // fix_orientation makes the same mesh acceptable.
+    EXPECT_NO_THROW(parse(R"({"mesh": ")" + data_file("bad/inverted") + R"(", "mesh_options": {"fix_orientation": true}})"));
+}
+
+TEST(SceneJsonErrors, BadJsonAndFiles) {
+    const std::string msg = expect_error("{\"mesh\": \"box:2x2x2\",\n \"dt\": }", {"scene.json", "invalid JSON", "line 2"});
+    EXPECT_EQ(msg.find("[json.exception"), std::string::npos) << msg;
+    try {
+        load_scene("/nonexistent/scene.json");
+        ADD_FAILURE() << "no error";
+    } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.json"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace edgefem::test
