@@ -5,12 +5,14 @@ namespace edgefem {
 namespace {
 std::string describe(const char* kind, index_t i, const std::string& file,
                      const std::vector<std::int64_t>& line, const std::vector<std::int64_t>& id) {
-    std::string out = std::string(kind) + " " + std::to_string(i);
+    // append() rather than "literal" + string: g++ 12 warns falsely (-Wrestrict) on the latter.
+    std::string out(kind);
+    out.append(" ").append(std::to_string(i));
     if (static_cast<std::size_t>(i) < id.size() && id[i] != i)
-        out += " (numbered " + std::to_string(id[i]) + " in the file)";
+        out.append(" (numbered ").append(std::to_string(id[i])).append(" in the file)");
     if (!file.empty()) {
-        out += " at " + file;
-        if (static_cast<std::size_t>(i) < line.size()) out += ":" + std::to_string(line[i]);
+        out.append(" at ").append(file);
+        if (static_cast<std::size_t>(i) < line.size()) out.append(":").append(std::to_string(line[i]));
     }
     return out;
 }

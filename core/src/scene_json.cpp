@@ -68,7 +68,8 @@ struct Context {
 void check_keys(const Context& cx, const json& obj, const std::string& path,
                 std::initializer_list<const char*> allowed) {
     if (!obj.is_object()) cx.fail(path, "expected an object, got " + show(obj));
-    for (const auto& [key, value] : obj.items()) {
+    for (const auto& item : obj.items()) {
+        const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture those
         if (std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) continue;
         std::string list;
         for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);

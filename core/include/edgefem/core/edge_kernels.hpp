@@ -102,28 +102,29 @@ inline void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict
 
 // TSEP term for the segment of first edge e0: Kp = 2 L(P) p~(E0) p~(E1)^T
 // added with sign (-1)^(i+j) to each of its 4 targets, transposed where the
-// target edge runs the other way. Kp and Kp^T sit side by side so the
-// transpose flag picks one by index arithmetic, not by a branch.
+// target edge runs the other way: K(E2) += s c x y^T with (x, y) = (p0, p1),
+// or (p1, p0) when transposed, picked by indexing, not by a branch. (A
+// scratch Kp written then re-read as vectors stalled on store forwarding.)
 template <class S>
 inline void tsep_stiffness_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict p, S* __restrict K) {
     const S* p0 = &p[3 * std::size_t(e0)];
     for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
         const S* p1 = &p[3 * std::size_t(m.tsep_other[P])];
         const S c = 2 * m.LP[P];
-        S kp[18];
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) {
-                kp[3 * i + j] = c * p0[i] * p1[j];
-                kp[9 + 3 * j + i] = kp[3 * i + j];
-            }
+        const S* ends[2] = {p0, p1};
         for (int k = 0; k < 4; ++k) {
             const index_t t = m.target[P][k];
-            const S* src = kp + 9 * (t & 1);
+            const S* x = ends[t & 1];
+            const S* y = ends[(t & 1) ^ 1];
+            const S cs = (k == 0 || k == 3) ? c : -c;
+            const S y0 = y[0], y1 = y[1], y2 = y[2];
             S* blk = &K[9 * std::size_t(t >> 1)];
-            if (k == 0 || k == 3)
-                for (int i = 0; i < 9; ++i) blk[i] += src[i];
-            else
-                for (int i = 0; i < 9; ++i) blk[i] -= src[i];
+            for (int i = 0; i < 3; ++i) {
+                const S xi = cs * x[i];
+                blk[3 * i] += xi * y0;
+                blk[3 * i + 1] += xi * y1;
+                blk[3 * i + 2] += xi * y2;
+            }
         }
     }
 }
