@@ -14,6 +14,11 @@ packages=(
   nlohmann-json3-dev  # scene files
   python3-getfem      # tests: GetFEM reference for `edgefem static` (system python3)
   libfmt-dev
+  pybind11-dev        # Python bindings (build/python/edgefem*.so)
+  python3-dev         # Python headers for the bindings
+  python3-numpy       # Python bindings: arrays (system python3)
+  python3-pytest      # tests: the Python suite
+  doxygen             # API reference (ctest api_reference_doxygen)
 )
 
 missing=()

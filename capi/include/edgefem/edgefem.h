@@ -1,0 +1,206 @@
+/**
+ * @file edgefem.h
+ * @brief The edgefem C API: a small, stable interface for game engines and
+ * foreign-function interfaces.
+ *
+ * Two opaque handles: an ::edgefem_scene describes what is simulated (mesh,
+ * material, fixed vertices, gravity, time step, integrator); an
+ * ::edgefem_sim, created from a scene, owns the state and steps it. Every
+ * function that can fail returns an ::edgefem_status; on failure,
+ * edgefem_last_error() gives a message for the calling thread. No C++
+ * exception ever crosses this interface.
+ *
+ * Vectors are xyz-interleaved doubles, 3 per vertex; vertex and tet indices
+ * are 0-based int32. Buffer sizes are passed as counts of doubles (or
+ * indices) and checked.
+ *
+ * @code
+ * edgefem_scene* scene = NULL;
+ * edgefem_sim* sim = NULL;
+ * if (edgefem_scene_create_from_arrays(X, nv, tets, nt, &scene) != EDGEFEM_OK ||
+ *     edgefem_scene_set_gravity(scene, 0, 0, -9.81) != EDGEFEM_OK ||
+ *     edgefem_sim_create(scene, &sim) != EDGEFEM_OK)
+ *     fprintf(stderr, "%s\n", edgefem_last_error());
+ * edgefem_sim_step(sim, NULL);
+ * edgefem_sim_get_positions(sim, x, 3 * (size_t)nv);
+ * edgefem_sim_destroy(sim);
+ * edgefem_scene_destroy(scene);
+ * @endcode
+ */
+#ifndef EDGEFEM_EDGEFEM_H
+#define EDGEFEM_EDGEFEM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32)
+#  if defined(EDGEFEM_C_BUILDING)
+#    define EDGEFEM_C_EXPORT __declspec(dllexport)
+#  else
+#    define EDGEFEM_C_EXPORT __declspec(dllimport)
+#  endif
+#else
+#  define EDGEFEM_C_EXPORT __attribute__((visibility("default")))
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Version of this interface; bumped only on incompatible changes. */
+#define EDGEFEM_C_API_VERSION 1
+
+/** Result of every fallible call. */
+typedef enum edgefem_status {
+    EDGEFEM_OK = 0,                    /**< success */
+    EDGEFEM_ERROR_NULL_POINTER = 1,    /**< a required pointer argument was NULL */
+    EDGEFEM_ERROR_INVALID_ARGUMENT = 2,/**< a value out of range, a size mismatch, an invalid scene */
+    EDGEFEM_ERROR_MESH = 3,            /**< an unreadable or invalid mesh (NaN, index out of range, ...) */
+    EDGEFEM_ERROR_FILE = 4,            /**< a scene file that cannot be read or parsed */
+    EDGEFEM_ERROR_SIMULATION = 5,      /**< a step or solve failed (non-finite state, no convergence) */
+    EDGEFEM_ERROR_OUT_OF_MEMORY = 6,   /**< an allocation failed */
+    EDGEFEM_ERROR_INTERNAL = 7         /**< anything else (a bug: please report it) */
+} edgefem_status;
+
+/** Time integrators (see docs/scenes.md). */
+typedef enum edgefem_integrator {
+    EDGEFEM_EXPLICIT = 0,      /**< symplectic Euler */
+    EDGEFEM_SEMI_IMPLICIT = 1, /**< linearised backward Euler, one CG solve per step */
+    EDGEFEM_IMPLICIT = 2       /**< backward Euler by Newton */
+} edgefem_integrator;
+
+/** Elastic models. */
+typedef enum edgefem_model {
+    EDGEFEM_MODEL_FE = 0, /**< StVK finite elements (edge-based form) */
+    EDGEFEM_MODEL_SN = 1  /**< the nonlinear spring network (its special case) */
+} edgefem_model;
+
+/** What a step cost and did (a subset of the C++ StepStats). */
+typedef struct edgefem_step_stats {
+    double force_ms;          /**< internal forces */
+    double stiffness_ms;      /**< building K */
+    double solve_ms;          /**< linear solves */
+    int32_t solver_iterations;/**< CG iterations */
+    int32_t newton_iterations;/**< Newton iterations (implicit) */
+    double residual;          /**< final relative residual of the last solve */
+    int32_t inverted_tets;    /**< tets with non-positive volume at the end of the step */
+} edgefem_step_stats;
+
+/** Energies of the current state (J). */
+typedef struct edgefem_energies {
+    double kinetic;  /**< 1/2 v^T M v */
+    double elastic;  /**< strain energy */
+    double gravity;  /**< gravitational potential, -m g.x summed */
+    double total;    /**< their sum */
+} edgefem_energies;
+
+/** A scene under construction (opaque). */
+typedef struct edgefem_scene edgefem_scene;
+/** A running simulation (opaque). */
+typedef struct edgefem_sim edgefem_sim;
+
+/** The library version, e.g. "0.1.0" (static storage). */
+EDGEFEM_C_EXPORT const char* edgefem_version_string(void);
+/** The message of the last failed call on this thread ("" when none); valid
+ *  until the next failing call on the same thread. */
+EDGEFEM_C_EXPORT const char* edgefem_last_error(void);
+/** A short name for a status code, e.g. "EDGEFEM_ERROR_MESH" (static storage). */
+EDGEFEM_C_EXPORT const char* edgefem_status_string(edgefem_status status);
+
+/* ---- Scenes ------------------------------------------------------------ */
+
+/** A scene from arrays: `positions` holds 3 `num_vertices` rest coordinates
+ *  (metres), `tets` 4 `num_tets` 0-based vertex indices. The mesh is copied
+ *  and validated (finite coordinates, indices in range, no degenerate,
+ *  duplicate or inverted tets). Defaults: Y = 1e5 Pa, nu = 0.3,
+ *  rho = 1000 kg/m^3, no gravity, semi-implicit, dt = 1e-3 s. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_arrays(const double* positions, int32_t num_vertices,
+                                                                 const int32_t* tets, int32_t num_tets,
+                                                                 edgefem_scene** out);
+/** A scene on a mesh file (TetGen .node/.ele or prefix, Gmsh .msh, MEDIT
+ *  .mesh, Vega .veg) or a "box:NXxNYxNZ" spec, with the defaults above. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_mesh_file(const char* path, edgefem_scene** out);
+/** A scene from a JSON scene file (docs/scenes.md): everything it sets. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_json(const char* path, edgefem_scene** out);
+/** A scene on a generated box of nx x ny x nz cubes of side `cell`, centred at
+ *  the origin; vertex (i, j, k) has index i + (nx+1) (j + (ny+1) k). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_box(int32_t nx, int32_t ny, int32_t nz, double cell,
+                                                         edgefem_scene** out);
+/** Frees a scene (NULL is ignored). Simulations created from it stay valid. */
+EDGEFEM_C_EXPORT void edgefem_scene_destroy(edgefem_scene* scene);
+
+/** Number of vertices and tets. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_counts(const edgefem_scene* scene, int32_t* num_vertices,
+                                                     int32_t* num_tets);
+/** Copies the rest positions (count = 3 x num_vertices). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_rest_positions(const edgefem_scene* scene, double* out,
+                                                                 size_t count);
+/** One material for the whole mesh: Young's modulus (Pa), Poisson ratio in
+ *  (-1, 0.5), density (kg/m^3). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_material(edgefem_scene* scene, double young, double poisson,
+                                                           double density);
+/** Replaces the fixed vertices (held at rest); count 0 frees all. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_fixed(edgefem_scene* scene, const int32_t* vertices,
+                                                        size_t count);
+/** Gravity (m/s^2). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_gravity(edgefem_scene* scene, double gx, double gy, double gz);
+/** Time step (s, finite and > 0). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt);
+/** Integrator. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator);
+/** Elastic model (FE or SN). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_model(edgefem_scene* scene, edgefem_model model);
+/** Rayleigh damping D = alpha M + beta K. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_damping(edgefem_scene* scene, double alpha, double beta);
+/** CG settings: relative tolerance, iteration cap, and a fixed budget
+ *  (`fixed_iterations` > 0: exactly that many warm-started iterations per
+ *  solve, the real-time setting; 0: iterate to the tolerance). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_cg(edgefem_scene* scene, double tolerance,
+                                                     int32_t max_iterations, int32_t fixed_iterations);
+
+/* ---- Simulations ------------------------------------------------------- */
+
+/** Validates the scene and builds a simulation at rest (u = 0, v = 0). The
+ *  scene is copied: later changes to it do not affect the simulation. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_create(const edgefem_scene* scene, edgefem_sim** out);
+/** Frees a simulation (NULL is ignored). */
+EDGEFEM_C_EXPORT void edgefem_sim_destroy(edgefem_sim* sim);
+
+/** Number of vertices. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_num_vertices(const edgefem_sim* sim, int32_t* out);
+/** Advances by dt; `stats` may be NULL. On EDGEFEM_ERROR_SIMULATION the
+ *  message names the step and vertex. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_step(edgefem_sim* sim, edgefem_step_stats* stats);
+/** Static equilibrium under the current loads; the result becomes the state.
+ *  `converged` may be NULL. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_solve_static(edgefem_sim* sim, int32_t* converged);
+
+/** Replaces all external forces (N, count = 3 x num_vertices); they stay until changed. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_set_external_forces(edgefem_sim* sim, const double* forces,
+                                                                size_t count);
+/** Sets the external force on one vertex. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_set_external_force(edgefem_sim* sim, int32_t vertex, double fx,
+                                                               double fy, double fz);
+/** Zeroes all external forces. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_clear_external_forces(edgefem_sim* sim);
+
+/** Current positions X + u (count = 3 x num_vertices). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_get_positions(const edgefem_sim* sim, double* out, size_t count);
+/** Displacement u = x - X (count = 3 x num_vertices). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_get_displacement(const edgefem_sim* sim, double* out, size_t count);
+/** Velocity (count = 3 x num_vertices). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_get_velocity(const edgefem_sim* sim, double* out, size_t count);
+/** Sets the displacement (count = 3 num_vertices, finite). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_set_displacement(edgefem_sim* sim, const double* u, size_t count);
+/** Sets the velocity (count = 3 num_vertices, finite). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_set_velocity(edgefem_sim* sim, const double* v, size_t count);
+/** Energies of the current state. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_energies(edgefem_sim* sim, edgefem_energies* out);
+/** Simulated time (s) and number of steps taken; either may be NULL. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_time(const edgefem_sim* sim, double* time, int64_t* steps);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* EDGEFEM_EDGEFEM_H */

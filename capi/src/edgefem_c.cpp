@@ -1,0 +1,452 @@
+// The C API (capi/include/edgefem/edgefem.h) over the C++ core. Every entry
+// point runs its body inside guard(), which turns any exception into a
+// status code and a thread-local message: nothing throws across the C
+// boundary.
+#include "edgefem/edgefem.h"
+
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+#include <utility>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/make_box.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/scene_json.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/core/validate_mesh.hpp"
+
+#ifndef EDGEFEM_VERSION
+#define EDGEFEM_VERSION "unknown"
+#endif
+
+struct edgefem_scene {
+    edgefem::Scene scene;
+};
+
+struct edgefem_sim {
+    explicit edgefem_sim(edgefem::Scene s) : sim(std::move(s)) {}
+    edgefem::Simulator<double> sim;
+};
+
+namespace {
+
+thread_local std::string g_last_error;
+
+// An error raised by the C layer itself, with its status.
+struct CError {
+    edgefem_status status;
+    std::string message;
+};
+
+edgefem_status fail(edgefem_status status, std::string message) {
+    try {
+        g_last_error = std::move(message);
+    } catch (...) {
+        g_last_error.clear();
+    }
+    return status;
+}
+
+// Runs body (returning void); maps every exception to a status. A bare
+// InvalidArgument becomes `invalid_status` (EDGEFEM_ERROR_FILE for scene files).
+template <class Body>
+edgefem_status guard(const char* fn, Body&& body, edgefem_status invalid_status = EDGEFEM_ERROR_INVALID_ARGUMENT) {
+    const std::string prefix = std::string(fn) + ": ";
+    try {
+        body();
+        return EDGEFEM_OK;
+    } catch (const CError& e) {
+        return fail(e.status, prefix + e.message);
+    } catch (const edgefem::SimulationError& e) {
+        return fail(EDGEFEM_ERROR_SIMULATION, prefix + e.what());
+    } catch (const edgefem::MeshError& e) {
+        return fail(EDGEFEM_ERROR_MESH, prefix + e.what());
+    } catch (const edgefem::InvalidArgument& e) {
+        return fail(invalid_status, prefix + e.what());
+    } catch (const edgefem::Error& e) {
+        return fail(invalid_status == EDGEFEM_ERROR_FILE ? EDGEFEM_ERROR_FILE : EDGEFEM_ERROR_INTERNAL,
+                    prefix + e.what());
+    } catch (const std::bad_alloc&) {
+        return fail(EDGEFEM_ERROR_OUT_OF_MEMORY, prefix + "out of memory");
+    } catch (const std::exception& e) {
+        return fail(EDGEFEM_ERROR_INTERNAL, prefix + e.what());
+    } catch (...) {
+        return fail(EDGEFEM_ERROR_INTERNAL, prefix + "unknown exception");
+    }
+}
+
+void require(const void* p, const char* name) {
+    if (!p) throw CError{EDGEFEM_ERROR_NULL_POINTER, std::string(name) + " is NULL"};
+}
+
+[[noreturn]] void invalid(std::string message) { throw CError{EDGEFEM_ERROR_INVALID_ARGUMENT, std::move(message)}; }
+
+void require_count(size_t count, size_t expected, const char* name) {
+    if (count != expected)
+        invalid(std::string(name) + ": count is " + std::to_string(count) + ", expected 3 x #V = " +
+                std::to_string(expected));
+}
+
+void require_finite(const double* a, size_t n, const char* name) {
+    for (size_t i = 0; i < n; ++i)
+        if (!std::isfinite(a[i]))
+            invalid(std::string(name) + "[" + std::to_string(i) + "] is not finite (vertex " +
+                    std::to_string(i / 3) + ")");
+}
+
+edgefem::Scene default_scene_for(edgefem::Mesh mesh) {
+    edgefem::Scene s;
+    s.mesh = std::move(mesh);
+    s.materials = edgefem::Material{};
+    return s;
+}
+
+edgefem_status make_scene(const char* fn, edgefem_scene** out, edgefem::Mesh (*build)(const void*),
+                          const void* ctx, edgefem_status invalid_status = EDGEFEM_ERROR_INVALID_ARGUMENT) {
+    if (out) *out = nullptr;
+    return guard(fn, [&] {
+        require(out, "out");
+        edgefem::Mesh mesh = build(ctx);
+        edgefem::validate_mesh(mesh);
+        *out = new edgefem_scene{default_scene_for(std::move(mesh))};
+    }, invalid_status);
+}
+
+std::size_t dofs(const edgefem_sim* sim) { return 3 * std::size_t(sim->sim.num_vertices()); }
+
+}  // namespace
+
+extern "C" {
+
+const char* edgefem_version_string(void) { return EDGEFEM_VERSION; }
+
+const char* edgefem_last_error(void) { return g_last_error.c_str(); }
+
+const char* edgefem_status_string(edgefem_status status) {
+    switch (status) {
+        case EDGEFEM_OK: return "EDGEFEM_OK";
+        case EDGEFEM_ERROR_NULL_POINTER: return "EDGEFEM_ERROR_NULL_POINTER";
+        case EDGEFEM_ERROR_INVALID_ARGUMENT: return "EDGEFEM_ERROR_INVALID_ARGUMENT";
+        case EDGEFEM_ERROR_MESH: return "EDGEFEM_ERROR_MESH";
+        case EDGEFEM_ERROR_FILE: return "EDGEFEM_ERROR_FILE";
+        case EDGEFEM_ERROR_SIMULATION: return "EDGEFEM_ERROR_SIMULATION";
+        case EDGEFEM_ERROR_OUT_OF_MEMORY: return "EDGEFEM_ERROR_OUT_OF_MEMORY";
+        case EDGEFEM_ERROR_INTERNAL: return "EDGEFEM_ERROR_INTERNAL";
+    }
+    return "EDGEFEM_ERROR_UNKNOWN";
+}
+
+// ---- Scenes ----
+
+edgefem_status edgefem_scene_create_from_arrays(const double* positions, int32_t num_vertices, const int32_t* tets,
+                                                int32_t num_tets, edgefem_scene** out) {
+    struct Args {
+        const double* X;
+        int32_t nv;
+        const int32_t* T;
+        int32_t nt;
+    } args{positions, num_vertices, tets, num_tets};
+    return make_scene("edgefem_scene_create_from_arrays", out, [](const void* p) {
+        const Args& a = *static_cast<const Args*>(p);
+        require(a.X, "positions");
+        require(a.T, "tets");
+        if (a.nv <= 0) invalid("num_vertices must be positive, got " + std::to_string(a.nv));
+        if (a.nt <= 0) invalid("num_tets must be positive, got " + std::to_string(a.nt));
+        edgefem::Mesh m;
+        m.X.assign(a.X, a.X + 3 * std::size_t(a.nv));
+        m.tets.assign(a.T, a.T + 4 * std::size_t(a.nt));
+        return m;
+    }, &args);
+}
+
+edgefem_status edgefem_scene_create_from_mesh_file(const char* path, edgefem_scene** out) {
+    return make_scene("edgefem_scene_create_from_mesh_file", out, [](const void* p) {
+        const char* path = static_cast<const char*>(p);
+        require(path, "path");
+        const std::string s(path);
+        return edgefem::is_box_spec(s) ? edgefem::make_box_from_spec(s) : edgefem::read_mesh(s);
+    }, path);
+}
+
+edgefem_status edgefem_scene_create_box(int32_t nx, int32_t ny, int32_t nz, double cell, edgefem_scene** out) {
+    struct Args {
+        int32_t nx, ny, nz;
+        double cell;
+    } args{nx, ny, nz, cell};
+    return make_scene("edgefem_scene_create_box", out, [](const void* p) {
+        const Args& a = *static_cast<const Args*>(p);
+        if (!(std::isfinite(a.cell) && a.cell > 0)) invalid("cell must be finite and positive");
+        return edgefem::make_box(a.nx, a.ny, a.nz, a.cell);
+    }, &args);
+}
+
+edgefem_status edgefem_scene_create_from_json(const char* path, edgefem_scene** out) {
+    if (out) *out = nullptr;
+    return guard("edgefem_scene_create_from_json", [&] {
+        require(out, "out");
+        require(path, "path");
+        edgefem::SceneFile file = edgefem::load_scene(path);
+        *out = new edgefem_scene{std::move(file.scene)};
+    }, EDGEFEM_ERROR_FILE);
+}
+
+void edgefem_scene_destroy(edgefem_scene* scene) { delete scene; }
+
+edgefem_status edgefem_scene_counts(const edgefem_scene* scene, int32_t* num_vertices, int32_t* num_tets) {
+    return guard("edgefem_scene_counts", [&] {
+        require(scene, "scene");
+        if (num_vertices) *num_vertices = scene->scene.mesh.num_vertices();
+        if (num_tets) *num_tets = scene->scene.mesh.num_tets();
+    });
+}
+
+edgefem_status edgefem_scene_get_rest_positions(const edgefem_scene* scene, double* out, size_t count) {
+    return guard("edgefem_scene_get_rest_positions", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        const auto& X = scene->scene.mesh.X;
+        require_count(count, X.size(), "out");
+        std::copy(X.begin(), X.end(), out);
+    });
+}
+
+edgefem_status edgefem_scene_set_material(edgefem_scene* scene, double young, double poisson, double density) {
+    return guard("edgefem_scene_set_material", [&] {
+        require(scene, "scene");
+        const edgefem::Material m{young, poisson, density};
+        m.validate();
+        scene->scene.materials = edgefem::Materials(m);
+    });
+}
+
+edgefem_status edgefem_scene_set_fixed(edgefem_scene* scene, const int32_t* vertices, size_t count) {
+    return guard("edgefem_scene_set_fixed", [&] {
+        require(scene, "scene");
+        if (count > 0) require(vertices, "vertices");
+        const int32_t nv = scene->scene.mesh.num_vertices();
+        for (size_t i = 0; i < count; ++i)
+            if (vertices[i] < 0 || vertices[i] >= nv)
+                invalid("vertices[" + std::to_string(i) + "] = " + std::to_string(vertices[i]) +
+                        " is out of range [0, " + std::to_string(nv) + ")");
+        scene->scene.fixed.assign(vertices, vertices + count);
+    });
+}
+
+edgefem_status edgefem_scene_set_gravity(edgefem_scene* scene, double gx, double gy, double gz) {
+    return guard("edgefem_scene_set_gravity", [&] {
+        require(scene, "scene");
+        const double g[3] = {gx, gy, gz};
+        require_finite(g, 3, "gravity");
+        scene->scene.gravity = {gx, gy, gz};
+    });
+}
+
+edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt) {
+    return guard("edgefem_scene_set_dt", [&] {
+        require(scene, "scene");
+        if (!(std::isfinite(dt) && dt > 0)) invalid("dt must be finite and positive, got " + std::to_string(dt));
+        scene->scene.dt = dt;
+    });
+}
+
+edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator) {
+    return guard("edgefem_scene_set_integrator", [&] {
+        require(scene, "scene");
+        switch (integrator) {
+            case EDGEFEM_EXPLICIT: scene->scene.integrator = edgefem::Integrator::Explicit; break;
+            case EDGEFEM_SEMI_IMPLICIT: scene->scene.integrator = edgefem::Integrator::SemiImplicit; break;
+            case EDGEFEM_IMPLICIT: scene->scene.integrator = edgefem::Integrator::Implicit; break;
+            default: invalid("unknown integrator " + std::to_string(int(integrator)));
+        }
+    });
+}
+
+edgefem_status edgefem_scene_set_model(edgefem_scene* scene, edgefem_model model) {
+    return guard("edgefem_scene_set_model", [&] {
+        require(scene, "scene");
+        switch (model) {
+            case EDGEFEM_MODEL_FE: scene->scene.model = edgefem::ModelKind::FE; break;
+            case EDGEFEM_MODEL_SN: scene->scene.model = edgefem::ModelKind::SN; break;
+            default: invalid("unknown model " + std::to_string(int(model)));
+        }
+    });
+}
+
+edgefem_status edgefem_scene_set_damping(edgefem_scene* scene, double alpha, double beta) {
+    return guard("edgefem_scene_set_damping", [&] {
+        require(scene, "scene");
+        if (!(std::isfinite(alpha) && alpha >= 0 && std::isfinite(beta) && beta >= 0))
+            invalid("damping coefficients must be finite and non-negative");
+        scene->scene.rayleigh_alpha = alpha;
+        scene->scene.rayleigh_beta = beta;
+    });
+}
+
+edgefem_status edgefem_scene_set_cg(edgefem_scene* scene, double tolerance, int32_t max_iterations,
+                                    int32_t fixed_iterations) {
+    return guard("edgefem_scene_set_cg", [&] {
+        require(scene, "scene");
+        if (!(std::isfinite(tolerance) && tolerance > 0)) invalid("tolerance must be finite and positive");
+        if (max_iterations <= 0) invalid("max_iterations must be positive");
+        if (fixed_iterations < 0) invalid("fixed_iterations must be >= 0");
+        scene->scene.solver.cg_tolerance = tolerance;
+        scene->scene.solver.cg_max_iterations = max_iterations;
+        scene->scene.solver.cg_fixed_iterations = fixed_iterations;
+    });
+}
+
+// ---- Simulations ----
+
+edgefem_status edgefem_sim_create(const edgefem_scene* scene, edgefem_sim** out) {
+    if (out) *out = nullptr;
+    return guard("edgefem_sim_create", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        *out = new edgefem_sim(scene->scene);
+    });
+}
+
+void edgefem_sim_destroy(edgefem_sim* sim) { delete sim; }
+
+edgefem_status edgefem_sim_num_vertices(const edgefem_sim* sim, int32_t* out) {
+    return guard("edgefem_sim_num_vertices", [&] {
+        require(sim, "sim");
+        require(out, "out");
+        *out = sim->sim.num_vertices();
+    });
+}
+
+edgefem_status edgefem_sim_step(edgefem_sim* sim, edgefem_step_stats* stats) {
+    return guard("edgefem_sim_step", [&] {
+        require(sim, "sim");
+        const edgefem::StepStats& s = sim->sim.step();
+        if (stats) {
+            stats->force_ms = s.force_ms;
+            stats->stiffness_ms = s.stiffness_ms;
+            stats->solve_ms = s.solve_ms;
+            stats->solver_iterations = s.solver_iterations;
+            stats->newton_iterations = s.newton_iterations;
+            stats->residual = s.residual;
+            stats->inverted_tets = s.inverted_tets;
+        }
+    });
+}
+
+edgefem_status edgefem_sim_solve_static(edgefem_sim* sim, int32_t* converged) {
+    return guard("edgefem_sim_solve_static", [&] {
+        require(sim, "sim");
+        const edgefem::StaticResult r = sim->sim.solve_static();
+        if (converged) *converged = r.converged ? 1 : 0;
+    });
+}
+
+edgefem_status edgefem_sim_set_external_forces(edgefem_sim* sim, const double* forces, size_t count) {
+    return guard("edgefem_sim_set_external_forces", [&] {
+        require(sim, "sim");
+        require(forces, "forces");
+        require_count(count, dofs(sim), "forces");
+        require_finite(forces, count, "forces");
+        std::copy(forces, forces + count, sim->sim.external_forces().begin());
+    });
+}
+
+edgefem_status edgefem_sim_set_external_force(edgefem_sim* sim, int32_t vertex, double fx, double fy, double fz) {
+    return guard("edgefem_sim_set_external_force", [&] {
+        require(sim, "sim");
+        const int32_t nv = sim->sim.num_vertices();
+        if (vertex < 0 || vertex >= nv)
+            invalid("vertex " + std::to_string(vertex) + " is out of range [0, " + std::to_string(nv) + ")");
+        const double f[3] = {fx, fy, fz};
+        require_finite(f, 3, "force");
+        auto fe = sim->sim.external_forces();
+        for (int r = 0; r < 3; ++r) fe[3 * std::size_t(vertex) + r] = f[r];
+    });
+}
+
+edgefem_status edgefem_sim_clear_external_forces(edgefem_sim* sim) {
+    return guard("edgefem_sim_clear_external_forces", [&] {
+        require(sim, "sim");
+        auto fe = sim->sim.external_forces();
+        std::fill(fe.begin(), fe.end(), 0.0);
+    });
+}
+
+edgefem_status edgefem_sim_get_positions(const edgefem_sim* sim, double* out, size_t count) {
+    return guard("edgefem_sim_get_positions", [&] {
+        require(sim, "sim");
+        require(out, "out");
+        require_count(count, dofs(sim), "out");
+        const std::vector<double> x = sim->sim.positions();
+        std::copy(x.begin(), x.end(), out);
+    });
+}
+
+namespace {
+// The const C handle reads spans the C++ API exposes only as non-const.
+edgefem::Simulator<double>& mut(const edgefem_sim* sim) { return const_cast<edgefem_sim*>(sim)->sim; }
+}  // namespace
+
+edgefem_status edgefem_sim_get_displacement(const edgefem_sim* sim, double* out, size_t count) {
+    return guard("edgefem_sim_get_displacement", [&] {
+        require(sim, "sim");
+        require(out, "out");
+        require_count(count, dofs(sim), "out");
+        const auto u = mut(sim).displacement();
+        std::copy(u.begin(), u.end(), out);
+    });
+}
+
+edgefem_status edgefem_sim_get_velocity(const edgefem_sim* sim, double* out, size_t count) {
+    return guard("edgefem_sim_get_velocity", [&] {
+        require(sim, "sim");
+        require(out, "out");
+        require_count(count, dofs(sim), "out");
+        const auto v = mut(sim).velocity();
+        std::copy(v.begin(), v.end(), out);
+    });
+}
+
+edgefem_status edgefem_sim_set_displacement(edgefem_sim* sim, const double* u, size_t count) {
+    return guard("edgefem_sim_set_displacement", [&] {
+        require(sim, "sim");
+        require(u, "u");
+        require_count(count, dofs(sim), "u");
+        require_finite(u, count, "u");
+        std::copy(u, u + count, sim->sim.displacement().begin());
+    });
+}
+
+edgefem_status edgefem_sim_set_velocity(edgefem_sim* sim, const double* v, size_t count) {
+    return guard("edgefem_sim_set_velocity", [&] {
+        require(sim, "sim");
+        require(v, "v");
+        require_count(count, dofs(sim), "v");
+        require_finite(v, count, "v");
+        std::copy(v, v + count, sim->sim.velocity().begin());
+    });
+}
+
+edgefem_status edgefem_sim_energies(edgefem_sim* sim, edgefem_energies* out) {
+    return guard("edgefem_sim_energies", [&] {
+        require(sim, "sim");
+        require(out, "out");
+        const edgefem::Energies e = sim->sim.energies();
+        out->kinetic = e.kinetic;
+        out->elastic = e.elastic;
+        out->gravity = e.gravity;
+        out->total = e.total();
+    });
+}
+
+edgefem_status edgefem_sim_time(const edgefem_sim* sim, double* time, int64_t* steps) {
+    return guard("edgefem_sim_time", [&] {
+        require(sim, "sim");
+        if (time) *time = sim->sim.time();
+        if (steps) *steps = sim->sim.step_index();
+    });
+}
+
+}  // extern "C"

@@ -1,0 +1,25 @@
+# ctest install_consumer: cmake --install the build into PREFIX, then
+# configure, build and run examples/consumer against the installed package
+# only (CMAKE_PREFIX_PATH=PREFIX, no access to the build tree).
+foreach(v BUILD_DIR PREFIX CONSUMER_SOURCE CONSUMER_BUILD GENERATOR)
+  if(NOT DEFINED ${v})
+    message(FATAL_ERROR "consumer_test.cmake: ${v} not set")
+  endif()
+endforeach()
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "consumer: failed (${rc}): ${ARGN}")
+  endif()
+endfunction()
+file(REMOVE_RECURSE ${PREFIX} ${CONSUMER_BUILD})
+set(config_args)
+if(CONFIG)
+  set(config_args --config ${CONFIG})
+endif()
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${PREFIX} ${config_args})
+run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE} -B ${CONSUMER_BUILD} -G ${GENERATOR}
+    -DCMAKE_PREFIX_PATH=${PREFIX} -DCMAKE_CXX_COMPILER=${CXX} -DCMAKE_BUILD_TYPE=Release)
+run(${CMAKE_COMMAND} --build ${CONSUMER_BUILD} ${config_args})
+run(${CONSUMER_BUILD}/edgefem_consumer)
+message("consumer: ok")

@@ -1,0 +1,519 @@
+// The `edgefem` Python module (pybind11): meshes, scenes, the Simulator with
+// numpy views that alias its state, the elastic kernels, VTU output and a
+// small benchmark entry point. Vectors are numpy arrays of shape (#V, 3).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "edgefem/core/deformations.hpp"
+#include "edgefem/core/elastic_operator.hpp"
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/make_box.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/scene_json.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/core/validate_mesh.hpp"
+#include "edgefem/core/write_vtu.hpp"
+#ifdef EDGEFEM_PY_HAVE_PARALLEL
+#include "edgefem/parallel/executors.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
+#endif
+
+namespace py = pybind11;
+using namespace edgefem;
+
+namespace {
+
+using InArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using InIndex = py::array_t<index_t, py::array::c_style | py::array::forcecast>;
+
+// A (rows, cols) view of `data` that keeps `base` alive (no copy).
+template <class T>
+py::array view(T* data, py::ssize_t rows, py::ssize_t cols, py::handle base, bool writeable = true) {
+    py::array a;
+    if (cols == 1)
+        a = py::array_t<T>({rows}, {py::ssize_t(sizeof(T))}, data, base);
+    else
+        a = py::array_t<T>({rows, cols}, {py::ssize_t(sizeof(T)) * cols, py::ssize_t(sizeof(T))}, data, base);
+    if (!writeable) a.attr("flags").attr("writeable") = false;
+    return a;
+}
+
+// Checks that `a` holds exactly `n` values (any shape, e.g. (#V, 3) or 3 #V).
+void require_size(const py::array& a, std::size_t n, const char* what) {
+    if (std::size_t(a.size()) != n)
+        throw InvalidArgument(std::string(what) + ": expected " + std::to_string(n) + " values (#V x 3), got " +
+                              std::to_string(a.size()));
+}
+
+std::vector<double> to_vector(const InArray& a, std::size_t n, const char* what) {
+    require_size(a, n, what);
+    return std::vector<double>(a.data(), a.data() + n);
+}
+
+py::array_t<double> new_vectors(const std::vector<double>& v) {
+    py::array_t<double> out({py::ssize_t(v.size() / 3), py::ssize_t(3)});
+    std::copy(v.begin(), v.end(), out.mutable_data());
+    return out;
+}
+
+Mesh mesh_from_arrays(const InArray& X, const InIndex& tets, std::optional<std::vector<int>> region) {
+    if (X.size() % 3 != 0) throw InvalidArgument("X: size " + std::to_string(X.size()) + " is not a multiple of 3");
+    if (tets.size() % 4 != 0)
+        throw InvalidArgument("tets: size " + std::to_string(tets.size()) + " is not a multiple of 4");
+    Mesh m;
+    m.X.assign(X.data(), X.data() + X.size());
+    m.tets.assign(tets.data(), tets.data() + tets.size());
+    if (region) {
+        if (region->size() != std::size_t(m.num_tets())) throw InvalidArgument("region: expected one id per tet");
+        m.region = *region;
+    }
+    return m;
+}
+
+// The elastic kernels on their own, owning a copy of the mesh (the operator
+// keeps a reference to it).
+struct ElasticModel {
+    ElasticModel(Mesh m, const Materials& mat, ModelKind kind, Method method)
+        : mesh(std::move(m)), op(make_elastic_operator<double>(mesh, mat, kind, method)) {}
+    ElasticModel(const ElasticModel&) = delete;
+    ElasticModel& operator=(const ElasticModel&) = delete;
+    std::size_t dofs() const { return 3 * std::size_t(mesh.num_vertices()); }
+
+    Mesh mesh;
+    std::unique_ptr<ElasticOperator<double>> op;
+    bool have_state = false, have_stiffness = false;
+};
+
+using clock_type = std::chrono::steady_clock;
+
+// Times `call` for about `seconds` after a short warm-up; returns sorted ns.
+template <class Call>
+std::vector<double> time_calls(double seconds, Call&& call) {
+    if (!(seconds > 0)) throw InvalidArgument("seconds must be positive");
+    const auto budget = std::chrono::duration<double>(seconds);
+    for (const auto w0 = clock_type::now();;) {
+        call();
+        if (clock_type::now() - w0 >= 0.05 * budget) break;
+    }
+    std::vector<double> ns;
+    for (const auto start = clock_type::now(); ns.size() < 5 || clock_type::now() - start < budget;) {
+        const auto t0 = clock_type::now();
+        call();
+        ns.push_back(std::chrono::duration<double, std::nano>(clock_type::now() - t0).count());
+    }
+    std::sort(ns.begin(), ns.end());
+    return ns;
+}
+
+double median(const std::vector<double>& v) {
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::unique_ptr<Simulator<double>> make_simulator(Scene scene, const std::string& backend, int threads) {
+    if (backend == "serial") return std::make_unique<Simulator<double>>(std::move(scene));
+#ifdef EDGEFEM_PY_HAVE_PARALLEL
+    auto ex = make_executor(parse_backend(backend), threads);
+    return std::make_unique<Simulator<double>>(std::move(scene), ex, parallel_operator_factory<double>(ex));
+#else
+    (void)threads;
+    throw InvalidArgument("backend '" + backend + "': this build has no parallel module (use 'serial')");
+#endif
+}
+
+}  // namespace
+
+PYBIND11_MODULE(edgefem, m) {
+    m.doc() = "edgefem: edge-based StVK tetrahedral FEM (meshes, scenes, simulator, kernels).";
+    m.attr("__version__") = EDGEFEM_VERSION;
+#ifdef EDGEFEM_PY_HAVE_PARALLEL
+    m.attr("has_parallel") = true;
+#else
+    m.attr("has_parallel") = false;
+#endif
+
+    // Exceptions: edgefem.Error and its subclasses, with the C++ message.
+    static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
+    static py::exception<InvalidArgument> invalid(m, "InvalidArgument", error.ptr());
+    static py::exception<MeshError> mesh_error(m, "MeshError", error.ptr());
+    static py::exception<SimulationError> sim_error(m, "SimulationError", error.ptr());
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const SimulationError& e) {
+            sim_error(e.what());
+        } catch (const MeshError& e) {
+            mesh_error(e.what());
+        } catch (const InvalidArgument& e) {
+            invalid(e.what());
+        } catch (const Error& e) {
+            error(e.what());
+        }
+    });
+
+    py::enum_<ModelKind>(m, "ModelKind").value("FE", ModelKind::FE).value("SN", ModelKind::SN);
+    py::enum_<Method>(m, "Method").value("Edge", Method::Edge).value("Tet", Method::Tet);
+    py::enum_<Integrator>(m, "Integrator")
+        .value("Explicit", Integrator::Explicit)
+        .value("SemiImplicit", Integrator::SemiImplicit)
+        .value("Implicit", Integrator::Implicit);
+    py::enum_<LinearSolver>(m, "LinearSolver").value("CG", LinearSolver::CG).value("Direct", LinearSolver::Direct);
+
+    // ---- meshes ----
+    py::class_<Mesh>(m, "Mesh", "Rest positions X (#V, 3) and tets (#T, 4); both are views into the mesh.")
+        .def(py::init(&mesh_from_arrays), py::arg("X"), py::arg("tets"), py::arg("region") = py::none(),
+             "A mesh from arrays (copied; not validated: call validate()).")
+        .def_property(
+            "X", [](py::object self) {
+                Mesh& me = self.cast<Mesh&>();
+                return view(me.X.data(), me.num_vertices(), 3, self);
+            },
+            [](Mesh& me, const InArray& X) { me.X = to_vector(X, me.X.size(), "X"); })
+        .def_property_readonly("tets",
+                               [](py::object self) {
+                                   Mesh& me = self.cast<Mesh&>();
+                                   return view(me.tets.data(), me.num_tets(), 4, self, false);
+                               })
+        .def_readwrite("region", &Mesh::region)
+        .def_property_readonly("num_vertices", &Mesh::num_vertices)
+        .def_property_readonly("num_tets", &Mesh::num_tets)
+        .def(
+            "validate",
+            [](Mesh& me, bool fix_orientation) {
+                ValidationOptions o;
+                o.fix_orientation = fix_orientation;
+                return validate_mesh(me, o).warnings;
+            },
+            py::arg("fix_orientation") = false,
+            "Checks the mesh (raises MeshError naming the element); returns warnings.")
+        .def("copy", [](const Mesh& me) { return Mesh(me); })
+        .def("__repr__", [](const Mesh& me) {
+            return "<edgefem.Mesh " + std::to_string(me.num_vertices()) + " vertices, " +
+                   std::to_string(me.num_tets()) + " tets>";
+        });
+
+    m.def(
+        "read_mesh",
+        [](const std::string& path, bool validate) {
+            Mesh mesh = is_box_spec(path) ? make_box_from_spec(path) : read_mesh(path);
+            if (validate) validate_mesh(mesh);
+            return mesh;
+        },
+        py::arg("path"), py::arg("validate") = true,
+        "Reads a TetGen .node/.ele (or prefix), Gmsh .msh, MEDIT .mesh, Vega .veg, or 'box:NXxNYxNZ'.");
+    m.def("make_box", &make_box, py::arg("nx"), py::arg("ny"), py::arg("nz"), py::arg("cell") = 0.01,
+          "A box of nx x ny x nz cubes of side `cell` (6 tets each), centred at the origin.");
+    m.def("make_box_of_size", &make_box_of_size, py::arg("target_tets"),
+          "A box of about `target_tets` tets with the paper box's 5:2.5:2 aspect.");
+
+    // ---- output ----
+    m.def(
+        "write_vtu",
+        [](const std::string& path, const Mesh& mesh, std::optional<InArray> displacement,
+           std::optional<InArray> force) {
+            VtuFields f;
+            const std::size_t n = 3 * std::size_t(mesh.num_vertices());
+            if (displacement) require_size(*displacement, n, "displacement"), f.displacement = displacement->data();
+            if (force) require_size(*force, n, "force"), f.force = force->data();
+            write_vtu(path, mesh, f);
+        },
+        py::arg("path"), py::arg("mesh"), py::arg("displacement") = py::none(), py::arg("force") = py::none(),
+        "Writes a VTK .vtu frame (points X + displacement).");
+    py::class_<PvdSeries>(m, "PvdSeries", "A .pvd series: add(time, vtu_path) per frame; written on write()/close.")
+        .def(py::init<std::string>(), py::arg("pvd_path"))
+        .def("add", &PvdSeries::add, py::arg("time"), py::arg("vtu_path"))
+        .def("write", &PvdSeries::write)
+        .def("__enter__", [](py::object self) { return self; })
+        .def("__exit__", [](PvdSeries& s, py::args) { s.write(); });
+
+    // ---- scenes ----
+    py::class_<Material>(m, "Material")
+        .def(py::init([](double young, double poisson, double density) { return Material{young, poisson, density}; }),
+             py::arg("young") = 1e5, py::arg("poisson") = 0.3, py::arg("density") = 1000.0)
+        .def_readwrite("young", &Material::young)
+        .def_readwrite("poisson", &Material::poisson)
+        .def_readwrite("density", &Material::density)
+        .def_property_readonly("lame_lambda", &Material::lambda)
+        .def_property_readonly("lame_mu", &Material::mu)
+        .def("validate", &Material::validate)
+        .def("__repr__", [](const Material& x) {
+            return "<edgefem.Material young=" + std::to_string(x.young) + " poisson=" + std::to_string(x.poisson) +
+                   " density=" + std::to_string(x.density) + ">";
+        });
+
+    py::class_<SolverSettings>(m, "SolverSettings")
+        .def(py::init<>())
+        .def_readwrite("linear_solver", &SolverSettings::linear_solver)
+        .def_readwrite("cg_tolerance", &SolverSettings::cg_tolerance)
+        .def_readwrite("cg_max_iterations", &SolverSettings::cg_max_iterations)
+        .def_readwrite("cg_fixed_iterations", &SolverSettings::cg_fixed_iterations)
+        .def_readwrite("definite_stiffness", &SolverSettings::definite_stiffness)
+        .def_readwrite("newton_tolerance", &SolverSettings::newton_tolerance)
+        .def_readwrite("newton_max_iterations", &SolverSettings::newton_max_iterations)
+        .def_readwrite("load_steps", &SolverSettings::load_steps)
+        .def_readwrite("max_step_halvings", &SolverSettings::max_step_halvings);
+
+    py::class_<Scene>(m, "Scene", "Mesh, material, loads, constraints and integrator settings (docs/scenes.md).")
+        .def(py::init([](Mesh mesh, const Material& material, std::vector<index_t> fixed,
+                         std::array<double, 3> gravity, double dt, Integrator integrator, ModelKind model,
+                         Method method) {
+                 Scene s;
+                 s.mesh = std::move(mesh);
+                 s.materials = material;
+                 s.fixed = std::move(fixed);
+                 s.gravity = gravity;
+                 s.dt = dt;
+                 s.integrator = integrator;
+                 s.model = model;
+                 s.method = method;
+                 return s;
+             }),
+             py::arg("mesh"), py::arg("material") = Material{}, py::arg("fixed") = std::vector<index_t>{},
+             py::arg("gravity") = std::array<double, 3>{0, 0, 0}, py::arg("dt") = 1e-3,
+             py::arg("integrator") = Integrator::SemiImplicit, py::arg("model") = ModelKind::FE,
+             py::arg("method") = Method::Edge)
+        .def_static("from_json", [](const std::string& path) { return load_scene(path).scene; }, py::arg("path"),
+                    "Reads and validates a JSON scene file.")
+        .def_readwrite("mesh", &Scene::mesh)
+        .def_property(
+            "material", [](const Scene& s) { return s.materials.fallback; },
+            [](Scene& s, const Material& mat) { s.materials = Materials(mat); },
+            "The material of every region (setting it drops per-region materials).")
+        .def("set_region_material", [](Scene& s, int region, const Material& mat) { s.materials.by_region[region] = mat; },
+             py::arg("region"), py::arg("material"))
+        .def_readwrite("model", &Scene::model)
+        .def_readwrite("method", &Scene::method)
+        .def_readwrite("gravity", &Scene::gravity)
+        .def_readwrite("rayleigh_alpha", &Scene::rayleigh_alpha)
+        .def_readwrite("rayleigh_beta", &Scene::rayleigh_beta)
+        .def_readwrite("fixed", &Scene::fixed)
+        .def_property(
+            "prescribed",
+            [](const Scene& s) {
+                py::list out;
+                for (const auto& p : s.prescribed) out.append(py::make_tuple(p.vertex, p.target));
+                return out;
+            },
+            [](Scene& s, const std::vector<std::pair<index_t, std::array<double, 3>>>& ps) {
+                s.prescribed.clear();
+                for (const auto& [v, t] : ps) s.prescribed.push_back({v, t});
+            },
+            "List of (vertex, (x, y, z)) target positions.")
+        .def_readwrite("prescribed_steps", &Scene::prescribed_steps)
+        .def_readwrite("integrator", &Scene::integrator)
+        .def_readwrite("dt", &Scene::dt)
+        .def_readwrite("steps", &Scene::steps)
+        .def_readwrite("solver", &Scene::solver)
+        .def_readwrite("count_inverted_tets", &Scene::count_inverted_tets)
+        .def("validate", &Scene::validate);
+    m.def("load_scene", [](const std::string& path) { return load_scene(path).scene; }, py::arg("path"),
+          "Scene.from_json(path).");
+    m.def("default_scene", &default_scene, "The built-in beam scene of `edgefem simulate`.");
+
+    // ---- the simulator ----
+    py::class_<StepStats>(m, "StepStats")
+        .def_readonly("force_ms", &StepStats::force_ms)
+        .def_readonly("stiffness_ms", &StepStats::stiffness_ms)
+        .def_readonly("solve_ms", &StepStats::solve_ms)
+        .def_readonly("solver_iterations", &StepStats::solver_iterations)
+        .def_readonly("newton_iterations", &StepStats::newton_iterations)
+        .def_readonly("residual", &StepStats::residual)
+        .def_readonly("negative_curvature", &StepStats::negative_curvature)
+        .def_readonly("inverted_tets", &StepStats::inverted_tets)
+        .def_readonly("halvings", &StepStats::halvings)
+        .def("__repr__", [](const StepStats& s) {
+            return "<edgefem.StepStats iterations=" + std::to_string(s.solver_iterations) +
+                   " residual=" + std::to_string(s.residual) + ">";
+        });
+    py::class_<Energies>(m, "Energies")
+        .def_readonly("kinetic", &Energies::kinetic)
+        .def_readonly("elastic", &Energies::elastic)
+        .def_readonly("gravity", &Energies::gravity)
+        .def_property_readonly("total", &Energies::total);
+    py::class_<StaticResult>(m, "StaticResult")
+        .def_readonly("newton_iterations", &StaticResult::newton_iterations)
+        .def_readonly("load_steps", &StaticResult::load_steps)
+        .def_readonly("residual", &StaticResult::residual)
+        .def_readonly("converged", &StaticResult::converged);
+
+    using Sim = Simulator<double>;
+    auto vec_view = [](std::span<double> (Sim::*get)()) {
+        return [get](py::object self) {
+            Sim& s = self.cast<Sim&>();
+            return view((s.*get)().data(), s.num_vertices(), 3, self);
+        };
+    };
+    auto vec_set = [](std::span<double> (Sim::*get)(), const char* what) {
+        return [get, what](Sim& s, const InArray& a) {
+            auto dst = (s.*get)();
+            require_size(a, dst.size(), what);
+            std::copy(a.data(), a.data() + dst.size(), dst.begin());
+        };
+    };
+    py::class_<Sim>(m, "Simulator",
+                    "Steps a Scene (double precision). displacement, velocity and external_forces are (#V, 3) "
+                    "numpy views of the simulator's own state: writing into them changes the simulation.")
+        .def(py::init(&make_simulator), py::arg("scene"), py::arg("backend") = "serial", py::arg("threads") = 0,
+             "backend: 'serial', or 'omp'/'tbb' when edgefem.has_parallel (threads <= 0: all).")
+        .def("step", &Sim::step, py::return_value_policy::copy, py::call_guard<py::gil_scoped_release>(),
+             "Advances by scene.dt; raises SimulationError on failure.")
+        .def(
+            "run",
+            [](Sim& s, int steps) {
+                py::gil_scoped_release release;
+                for (int k = 0; k < steps; ++k) s.step();
+                return s.last_stats();
+            },
+            py::arg("steps"), "step() `steps` times; returns the last step's stats.")
+        .def("solve_static", &Sim::solve_static, py::call_guard<py::gil_scoped_release>())
+        .def("energies", &Sim::energies)
+        .def("positions", [](const Sim& s) { return new_vectors(s.positions()); }, "X + u (a new array).")
+        .def_property("displacement", vec_view(&Sim::displacement), vec_set(&Sim::displacement, "displacement"))
+        .def_property("velocity", vec_view(&Sim::velocity), vec_set(&Sim::velocity, "velocity"))
+        .def_property("external_forces", vec_view(&Sim::external_forces),
+                      vec_set(&Sim::external_forces, "external_forces"))
+        .def_property_readonly("forces",
+                               [](py::object self) {
+                                   Sim& s = self.cast<Sim&>();
+                                   auto f = s.forces();
+                                   return view(const_cast<double*>(f.data()), s.num_vertices(), 3, self, false);
+                               },
+                               "Internal elastic forces of the last evaluation (read-only view).")
+        .def_property_readonly("lumped_mass",
+                               [](py::object self) {
+                                   Sim& s = self.cast<Sim&>();
+                                   auto mm = s.lumped_mass();
+                                   return view(const_cast<double*>(mm.data()), s.num_vertices(), 1, self, false);
+                               })
+        .def_property_readonly("scene", &Sim::scene, py::return_value_policy::reference_internal)
+        .def_property_readonly("num_vertices", &Sim::num_vertices)
+        .def_property_readonly("step_index", &Sim::step_index)
+        .def_property_readonly("time", &Sim::time)
+        .def_property_readonly("last_stats", &Sim::last_stats, py::return_value_policy::copy);
+
+    // ---- kernels ----
+    py::class_<ElasticModel>(m, "ElasticModel",
+                             "The elastic kernels on a mesh: energy, forces f = dW/du, and K x, for displacements "
+                             "u = x - X of shape (#V, 3).")
+        .def(py::init([](const Mesh& mesh, const Material& material, ModelKind model, Method method) {
+                 return std::make_unique<ElasticModel>(mesh, Materials(material), model, method);
+             }),
+             py::arg("mesh"), py::arg("material") = Material{}, py::arg("model") = ModelKind::FE,
+             py::arg("method") = Method::Edge)
+        .def_property_readonly("num_vertices", [](const ElasticModel& em) { return em.mesh.num_vertices(); })
+        .def(
+            "energy", [](ElasticModel& em, const InArray& u) {
+                require_size(u, em.dofs(), "u");
+                return em.op->energy(u.data());
+            },
+            py::arg("u"), "W(u).")
+        .def(
+            "forces",
+            [](ElasticModel& em, const InArray& u) {
+                require_size(u, em.dofs(), "u");
+                py::array_t<double> f({py::ssize_t(em.mesh.num_vertices()), py::ssize_t(3)});
+                const double W = em.op->forces(u.data(), f.mutable_data(), true);
+                em.have_state = true;
+                em.have_stiffness = false;
+                return py::make_tuple(W, f);
+            },
+            py::arg("u"), "(W, f) with f = dW/du, shape (#V, 3).")
+        .def(
+            "build_stiffness",
+            [](ElasticModel& em, const InArray& u, bool definite) {
+                require_size(u, em.dofs(), "u");
+                std::vector<double> f(em.dofs());
+                em.op->forces(u.data(), f.data(), false);
+                em.op->build_stiffness(definite);
+                em.have_state = em.have_stiffness = true;
+            },
+            py::arg("u"), py::arg("definite") = false, "Builds the tangent stiffness K at u for multiply().")
+        .def(
+            "multiply",
+            [](const ElasticModel& em, const InArray& x) {
+                if (!em.have_stiffness) throw InvalidArgument("multiply: call build_stiffness(u) first");
+                require_size(x, em.dofs(), "x");
+                py::array_t<double> y({py::ssize_t(em.mesh.num_vertices()), py::ssize_t(3)});
+                em.op->multiply(x.data(), y.mutable_data());
+                return y;
+            },
+            py::arg("x"), "K x with the K of the last build_stiffness (K = d f / d u).")
+        .def(
+            "diagonal_blocks",
+            [](const ElasticModel& em) {
+                if (!em.have_stiffness) throw InvalidArgument("diagonal_blocks: call build_stiffness(u) first");
+                py::array_t<double> D({py::ssize_t(em.mesh.num_vertices()), py::ssize_t(3), py::ssize_t(3)});
+                em.op->diagonal_blocks(D.mutable_data());
+                return D;
+            },
+            "The 3x3 diagonal blocks of K, shape (#V, 3, 3).")
+        .def(
+            "inverted_tets",
+            [](const ElasticModel& em, const InArray& u) {
+                require_size(u, em.dofs(), "u");
+                return em.op->inverted_tets(u.data());
+            },
+            py::arg("u"));
+
+    m.def(
+        "deformation",
+        [](const Mesh& mesh, const std::string& kind, double scale) {
+            return new_vectors(deformation_displacement(mesh, parse_deformation(kind), scale));
+        },
+        py::arg("mesh"), py::arg("kind") = "twist", py::arg("scale") = 1.0,
+        "A test displacement: 'twist', 'rotate', 'random' or 'affine' (as the CLI's --deform).");
+
+    // ---- benchmarks ----
+    m.def(
+        "bench_forces",
+        [](const Mesh& mesh, double seconds, ModelKind model, Method method, const Material& material) {
+            ElasticModel em(mesh, Materials(material), model, method);
+            const std::vector<double> u = deformation_displacement(em.mesh, Deformation::Twist);
+            std::vector<double> f(u.size());
+            std::vector<double> ns;
+            {
+                py::gil_scoped_release release;
+                ns = time_calls(seconds, [&] { em.op->forces(u.data(), f.data(), false); });
+            }
+            py::dict r;
+            r["tets"] = mesh.num_tets();
+            r["calls"] = ns.size();
+            r["median_ms"] = median(ns) * 1e-6;
+            r["min_ms"] = ns.front() * 1e-6;
+            r["median_ns_per_tet"] = median(ns) / mesh.num_tets();
+            return r;
+        },
+        py::arg("mesh"), py::arg("seconds") = 0.5, py::arg("model") = ModelKind::FE, py::arg("method") = Method::Edge,
+        py::arg("material") = Material{},
+        "Times the force kernel on the twist configuration (as `edgefem bench --kernel force`).");
+    m.def(
+        "bench_step",
+        [](Sim& sim, double seconds) {
+            std::vector<double> ns;
+            std::vector<int> its;
+            {
+                py::gil_scoped_release release;
+                ns = time_calls(seconds, [&] { its.push_back(sim.step().solver_iterations); });
+            }
+            double mean_its = 0;
+            for (int i : its) mean_its += i;
+            py::dict r;
+            r["steps"] = ns.size();
+            r["median_ms_per_step"] = median(ns) * 1e-6;
+            r["min_ms_per_step"] = ns.front() * 1e-6;
+            r["max_ms_per_step"] = ns.back() * 1e-6;
+            r["cg_iterations"] = mean_its / double(its.size());
+            return r;
+        },
+        py::arg("simulator"), py::arg("seconds") = 0.5,
+        "Times simulator.step() (the state moves on), as `edgefem bench --kernel step`.");
+}

@@ -1,0 +1,257 @@
+/* The C API from C11: the paper's 1,200-tet box built from arrays, clamped
+ * at its x = min end, sagging under gravity; then the error paths. Prints
+ * "test_capi: ok" and exits 0 on success. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "edgefem/edgefem.h"
+
+static int failures = 0;
+
+#define CHECK(cond)                                                              \
+    do {                                                                         \
+        if (!(cond)) {                                                           \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
+            ++failures;                                                          \
+        }                                                                        \
+    } while (0)
+
+#define CHECK_OK(call)                                                                      \
+    do {                                                                                    \
+        edgefem_status s_ = (call);                                                         \
+        if (s_ != EDGEFEM_OK) {                                                             \
+            fprintf(stderr, "%s:%d: %s -> %s: %s\n", __FILE__, __LINE__, #call,             \
+                    edgefem_status_string(s_), edgefem_last_error());                       \
+            ++failures;                                                                     \
+        }                                                                                   \
+    } while (0)
+
+/* Expects `status` with a non-empty message containing `needle`. */
+static void expect_error(edgefem_status got, edgefem_status want, const char* needle, const char* what) {
+    const char* msg = edgefem_last_error();
+    if (got != want) {
+        fprintf(stderr, "%s: got %s, want %s (%s)\n", what, edgefem_status_string(got), edgefem_status_string(want),
+                msg);
+        ++failures;
+    } else if (msg == NULL || msg[0] == '\0' || (needle && strstr(msg, needle) == NULL)) {
+        fprintf(stderr, "%s: message '%s' lacks '%s'\n", what, msg ? msg : "(null)", needle ? needle : "");
+        ++failures;
+    } else {
+        printf("  %s -> %s: %s\n", what, edgefem_status_string(got), msg);
+    }
+}
+
+/* A box of nx x ny x nz cubes of side h centred at the origin, each cube
+ * split into 6 tets around its main diagonal, oriented positively. */
+static void make_box(int nx, int ny, int nz, double h, double** X, int32_t* nv, int32_t** T, int32_t* nt) {
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    const int sx = nx + 1, sy = ny + 1, sz = nz + 1;
+    *nv = sx * sy * sz;
+    *nt = 6 * nx * ny * nz;
+    *X = malloc(sizeof(double) * 3 * (size_t)*nv);
+    *T = malloc(sizeof(int32_t) * 4 * (size_t)*nt);
+    for (int k = 0; k < sz; ++k)
+        for (int j = 0; j < sy; ++j)
+            for (int i = 0; i < sx; ++i) {
+                double* p = *X + 3 * (size_t)(i + sx * (j + sy * k));
+                p[0] = (i - 0.5 * nx) * h;
+                p[1] = (j - 0.5 * ny) * h;
+                p[2] = (k - 0.5 * nz) * h;
+            }
+    int32_t* t = *T;
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                for (int p = 0; p < 6; ++p) {
+                    int c[3] = {i, j, k};
+                    for (int s = 0; s < 4; ++s) {
+                        if (s > 0) ++c[perms[p][s - 1]];
+                        t[s] = c[0] + sx * (c[1] + sy * c[2]);
+                    }
+                    /* orientation: swap the last two when the volume is negative */
+                    const double *a = *X + 3 * t[0], *b = *X + 3 * t[1], *cc = *X + 3 * t[2], *d = *X + 3 * t[3];
+                    double u[3], v[3], w[3];
+                    for (int r = 0; r < 3; ++r) {
+                        u[r] = b[r] - a[r];
+                        v[r] = cc[r] - a[r];
+                        w[r] = d[r] - a[r];
+                    }
+                    const double vol = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                                       u[2] * (v[0] * w[1] - v[1] * w[0]);
+                    if (vol < 0) {
+                        const int32_t tmp = t[2];
+                        t[2] = t[3];
+                        t[3] = tmp;
+                    }
+                    t += 4;
+                }
+}
+
+int main(void) {
+    printf("edgefem %s, C API %d\n", edgefem_version_string(), EDGEFEM_C_API_VERSION);
+    double* X;
+    int32_t* T;
+    int32_t nv, nt;
+    make_box(10, 5, 4, 0.01, &X, &nv, &T, &nt); /* 0.1 x 0.05 x 0.04 m, 1,200 tets */
+    CHECK(nv == 11 * 6 * 5 && nt == 1200);
+
+    /* ---- the happy path ---- */
+    edgefem_scene* scene = NULL;
+    CHECK_OK(edgefem_scene_create_from_arrays(X, nv, T, nt, &scene));
+    CHECK(scene != NULL);
+    int32_t cv = 0, ct = 0;
+    CHECK_OK(edgefem_scene_counts(scene, &cv, &ct));
+    CHECK(cv == nv && ct == nt);
+
+    int32_t* fixed = malloc(sizeof(int32_t) * (size_t)nv);
+    size_t nfixed = 0;
+    double xmax = -1;
+    for (int32_t v = 0; v < nv; ++v) {
+        if (X[3 * v] < -0.0499) fixed[nfixed++] = v;
+        if (X[3 * v] > xmax) xmax = X[3 * v];
+    }
+    CHECK(nfixed == 6 * 5);
+    CHECK_OK(edgefem_scene_set_fixed(scene, fixed, nfixed));
+    CHECK_OK(edgefem_scene_set_material(scene, 1e5, 0.3, 1000));
+    CHECK_OK(edgefem_scene_set_gravity(scene, 0, 0, -9.81));
+    CHECK_OK(edgefem_scene_set_dt(scene, 1e-3));
+    CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_SEMI_IMPLICIT));
+    CHECK_OK(edgefem_scene_set_cg(scene, 1e-6, 500, 0));
+
+    edgefem_sim* sim = NULL;
+    CHECK_OK(edgefem_sim_create(scene, &sim));
+    if (!sim) {
+        fprintf(stderr, "no simulation: giving up\n");
+        return 1;
+    }
+    edgefem_step_stats stats;
+    memset(&stats, 0, sizeof stats);
+    for (int k = 0; k < 50; ++k) CHECK_OK(edgefem_sim_step(sim, &stats));
+    CHECK(stats.solver_iterations > 0);
+    double t = 0;
+    int64_t steps = 0;
+    CHECK_OK(edgefem_sim_time(sim, &t, &steps));
+    CHECK(steps == 50 && fabs(t - 0.05) < 1e-12);
+
+    const size_t n3 = 3 * (size_t)nv;
+    double* x = malloc(sizeof(double) * n3);
+    double* u = malloc(sizeof(double) * n3);
+    CHECK_OK(edgefem_sim_get_positions(sim, x, n3));
+    CHECK_OK(edgefem_sim_get_displacement(sim, u, n3));
+    int finite = 1;
+    double free_end_uz = 0, fixed_max = 0;
+    int free_count = 0;
+    for (size_t i = 0; i < n3; ++i) {
+        if (!isfinite(x[i])) finite = 0;
+        if (fabs(x[i] - (X[i] + u[i])) > 1e-12) finite = 0;
+    }
+    for (int32_t v = 0; v < nv; ++v) {
+        if (X[3 * v] > xmax - 1e-9) {
+            free_end_uz += u[3 * v + 2];
+            ++free_count;
+        }
+    }
+    for (size_t i = 0; i < nfixed; ++i)
+        for (int r = 0; r < 3; ++r) fixed_max = fmax(fixed_max, fabs(u[3 * (size_t)fixed[i] + r]));
+    free_end_uz /= free_count;
+    printf("  after 50 steps: free end mean u_z = %.6g m, fixed max |u| = %g, CG its = %d\n", free_end_uz,
+           fixed_max, stats.solver_iterations);
+    CHECK(finite);
+    CHECK(free_end_uz < -1e-4); /* moved down under gravity */
+    CHECK(fixed_max == 0.0);
+
+    edgefem_energies e;
+    CHECK_OK(edgefem_sim_energies(sim, &e));
+    CHECK(isfinite(e.total) && e.elastic > 0 && e.kinetic >= 0 && e.gravity < 0);
+
+    /* External forces: push the free end up and see it respond. */
+    double* f = calloc(n3, sizeof(double));
+    for (int32_t v = 0; v < nv; ++v)
+        if (X[3 * v] > xmax - 1e-9) f[3 * v + 2] = 0.05;
+    CHECK_OK(edgefem_sim_set_external_forces(sim, f, n3));
+    CHECK_OK(edgefem_sim_set_external_force(sim, 0, 0, 0, 0));
+    for (int k = 0; k < 50; ++k) CHECK_OK(edgefem_sim_step(sim, NULL));
+    CHECK_OK(edgefem_sim_get_displacement(sim, u, n3));
+    double pushed_uz = 0;
+    for (int32_t v = 0; v < nv; ++v)
+        if (X[3 * v] > xmax - 1e-9) pushed_uz += u[3 * v + 2] / free_count;
+    printf("  pushed up: free end mean u_z = %.6g m\n", pushed_uz);
+    CHECK(pushed_uz > free_end_uz);
+    CHECK_OK(edgefem_sim_clear_external_forces(sim));
+
+    /* ---- error paths ---- */
+    printf("error paths:\n");
+    edgefem_scene* bad = (edgefem_scene*)0x1;
+    X[3 * 7 + 1] = NAN;
+    expect_error(edgefem_scene_create_from_arrays(X, nv, T, nt, &bad), EDGEFEM_ERROR_MESH, NULL, "NaN coordinate");
+    CHECK(bad == NULL); /* *out is cleared on failure */
+    X[3 * 7 + 1] = 0;
+    const int32_t saved = T[4 * 5 + 2];
+    T[4 * 5 + 2] = nv + 3;
+    expect_error(edgefem_scene_create_from_arrays(X, nv, T, nt, &bad), EDGEFEM_ERROR_MESH, NULL,
+                 "index out of range");
+    T[4 * 5 + 2] = saved;
+    expect_error(edgefem_scene_set_dt(scene, -1e-3), EDGEFEM_ERROR_INVALID_ARGUMENT, "dt", "negative dt");
+    expect_error(edgefem_scene_set_dt(scene, NAN), EDGEFEM_ERROR_INVALID_ARGUMENT, "dt", "NaN dt");
+    expect_error(edgefem_scene_set_material(scene, 1e5, 0.5, 1000), EDGEFEM_ERROR_INVALID_ARGUMENT, NULL,
+                 "Poisson 0.5");
+    const int32_t out_of_range = nv;
+    expect_error(edgefem_scene_set_fixed(scene, &out_of_range, 1), EDGEFEM_ERROR_INVALID_ARGUMENT, "out of range",
+                 "fixed vertex out of range");
+    expect_error(edgefem_scene_create_from_arrays(NULL, nv, T, nt, &bad), EDGEFEM_ERROR_NULL_POINTER, "positions",
+                 "NULL positions");
+    expect_error(edgefem_scene_create_from_arrays(X, nv, T, nt, NULL), EDGEFEM_ERROR_NULL_POINTER, "out",
+                 "NULL out");
+    expect_error(edgefem_sim_step(NULL, NULL), EDGEFEM_ERROR_NULL_POINTER, "sim", "NULL sim");
+    expect_error(edgefem_sim_get_positions(sim, NULL, n3), EDGEFEM_ERROR_NULL_POINTER, "out", "NULL buffer");
+    expect_error(edgefem_sim_get_positions(sim, x, n3 - 1), EDGEFEM_ERROR_INVALID_ARGUMENT, "count",
+                 "short buffer");
+    expect_error(edgefem_sim_set_external_force(sim, -1, 0, 0, 1), EDGEFEM_ERROR_INVALID_ARGUMENT, "vertex",
+                 "external force on vertex -1");
+    f[5] = INFINITY;
+    expect_error(edgefem_sim_set_external_forces(sim, f, n3), EDGEFEM_ERROR_INVALID_ARGUMENT, "not finite",
+                 "infinite force");
+    expect_error(edgefem_scene_create_from_mesh_file("/nonexistent/mesh.node", &bad), EDGEFEM_ERROR_MESH, NULL,
+                 "missing mesh file");
+    expect_error(edgefem_scene_create_from_json("/nonexistent/scene.json", &bad), EDGEFEM_ERROR_FILE, NULL,
+                 "missing scene file");
+    expect_error(edgefem_scene_set_integrator(scene, (edgefem_integrator)42), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                 "integrator", "unknown integrator");
+
+    /* An explicit step far beyond the stability limit fails as a simulation error. */
+    edgefem_scene* stiff = NULL;
+    CHECK_OK(edgefem_scene_create_box(4, 2, 2, 0.01, &stiff));
+    CHECK_OK(edgefem_scene_set_material(stiff, 1e9, 0.3, 1000));
+    CHECK_OK(edgefem_scene_set_integrator(stiff, EDGEFEM_EXPLICIT));
+    CHECK_OK(edgefem_scene_set_dt(stiff, 1e-2));
+    CHECK_OK(edgefem_scene_set_gravity(stiff, 0, 0, -9.81));
+    edgefem_sim* unstable = NULL;
+    CHECK_OK(edgefem_sim_create(stiff, &unstable));
+    edgefem_status st = EDGEFEM_OK;
+    for (int k = 0; k < 200 && st == EDGEFEM_OK; ++k) st = edgefem_sim_step(unstable, NULL);
+    expect_error(st, EDGEFEM_ERROR_SIMULATION, "step", "unstable explicit step");
+    edgefem_sim_destroy(unstable);
+    edgefem_scene_destroy(stiff);
+
+    /* The simulation still works after all that. */
+    CHECK_OK(edgefem_sim_step(sim, NULL));
+
+    edgefem_sim_destroy(sim);
+    edgefem_scene_destroy(scene);
+    edgefem_scene_destroy(NULL);
+    edgefem_sim_destroy(NULL);
+    free(f);
+    free(u);
+    free(x);
+    free(fixed);
+    free(X);
+    free(T);
+    if (failures) {
+        printf("test_capi: %d failure(s)\n", failures);
+        return 1;
+    }
+    printf("test_capi: ok\n");
+    return 0;
+}
