@@ -11,6 +11,8 @@
 #include "common.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/executors.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
 
 namespace edgefem::cli {
 
@@ -19,6 +21,7 @@ namespace {
 struct BenchOptions {
     MeshOptions mesh;
     ModelOptions model;
+    ExecOptions exec;
     std::string kernel;
     double seconds = 1.0;
     int cg_iters = 0;  // step: > 0 runs exactly this many CG iterations
@@ -64,6 +67,7 @@ void print_header(const BenchOptions& opts, const Mesh& mesh) {
     print_kv("method", opts.model.method);
     print_kv("model", opts.model.model);
     print_kv("precision", opts.model.precision);
+    print_kv("backend", opts.exec.describe());
 }
 
 // One semi-implicit step (dt = 1 ms) of the mesh standing on its lowest 1%
@@ -87,7 +91,10 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     scene.dt = 1e-3;
     scene.solver.cg_tolerance = 1e-6;
     scene.solver.cg_fixed_iterations = opts.cg_iters;
-    Simulator<S> sim(std::move(scene));
+    const auto ex = opts.exec.executor();
+    Simulator<S> sim(std::move(scene), ex,
+                     opts.exec.parallel_kernels() ? parallel_operator_factory<S>(ex, parse_variant(opts.exec.variant))
+                                                  : OperatorFactory<S>{});
 
     std::vector<int> iterations;  // of every call, warm-up included
     const std::vector<double> ns = time_calls(opts.seconds, [&] { iterations.push_back(sim.step().solver_iterations); });
@@ -122,7 +129,7 @@ void run_bench(const BenchOptions& opts) {
     const Kernel kernel = kKernels.at(opts.kernel);
     const Mesh& mesh = lm.mesh;
 
-    auto eval = make_evaluator(mesh, opts.model);
+    auto eval = make_evaluator(mesh, opts.model, opts.exec);
     eval->set_displacement(deformation_displacement(mesh, Deformation::Twist));
     // kx multiplies a generic (non-smooth) vector.
     eval->prepare(kernel, deformation_displacement(mesh, Deformation::Random));
@@ -148,10 +155,11 @@ void add_bench_command(CLI::App& app) {
     auto opts = std::make_shared<BenchOptions>();
     auto* cmd = app.add_subcommand(
         "bench",
-        "Time one kernel on the twist configuration, or one time step (single thread): a warm-up, then "
+        "Time one kernel on the twist configuration, or one time step, on the chosen back-end (--backend, --threads, --variant): a warm-up, then "
         "calls until --seconds have passed (at least 5); reports the median and minimum per call and per tet");
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/false);
+    add_exec_options(*cmd, opts->exec);
     cmd->add_option("--kernel", opts->kernel,
                     "force: forces only (no energy); stiffness: K from a previous force call's state (edge) or "
                     "the per-tet 12x12 blocks (tet); force+stiffness: both; kx: y = K x with K precomputed "

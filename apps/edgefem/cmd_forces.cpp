@@ -15,6 +15,7 @@ namespace {
 struct ForcesOptions {
     MeshOptions mesh;
     ModelOptions model;
+    ExecOptions exec;
     std::string pos, dir, deform, out;
 };
 
@@ -37,7 +38,7 @@ void run_forces(const ForcesOptions& opts) {
     std::vector<double> dir;
     if (!opts.dir.empty()) dir = read_vectors(opts.dir, nv);
 
-    auto eval = make_evaluator(mesh, opts.model);
+    auto eval = make_evaluator(mesh, opts.model, opts.exec);
     eval->set_displacement(u);
     std::vector<double> f;
     const auto t0 = std::chrono::steady_clock::now();
@@ -71,6 +72,7 @@ void add_forces_command(CLI::App& app) {
         "PREFIX.energy, PREFIX.force, PREFIX.Kdir (with --dir) and PREFIX.pos (with --deform), %.17g");
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/true);
+    add_exec_options(*cmd, opts->exec);
     auto* pos = cmd->add_option("--pos", opts->pos, "Current positions: one 'x y z' line per vertex (default: rest shape)");
     cmd->add_option("--dir", opts->dir, "Direction vector, one 'x y z' line per vertex: also write PREFIX.Kdir = K dir");
     cmd->add_option("--deform", opts->deform, "Generate the configuration instead of --pos (also writes PREFIX.pos)")

@@ -14,6 +14,7 @@
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/tet_kernels.hpp"
 #include "edgefem/core/topology.hpp"
+#include "edgefem/parallel/executors.hpp"
 
 namespace edgefem::cli {
 
@@ -77,6 +78,33 @@ void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required
         poisson->capture_default_str();
     }
     cmd.add_option("--density", opts.material.density, "Density (kg/m^3)")->capture_default_str();
+}
+
+// ---- Execution ------------------------------------------------------------
+
+std::shared_ptr<const Executor> ExecOptions::executor() const { return make_executor(parse_backend(backend), threads); }
+
+std::string ExecOptions::describe() const {
+    if (!parallel_kernels()) return "serial";
+    return std::string(backend) + " x" + std::to_string(executor()->threads()) + ", " + variant;
+}
+
+void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
+    cmd.add_option("--backend", opts.backend,
+                   "Where the kernels run: serial (core's loops), omp (OpenMP) or tbb (oneTBB)")
+        ->check(CLI::IsMember({"serial", "omp", "tbb"}))
+        ->capture_default_str();
+    cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb back-end (0: all hardware threads)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    if (with_variant)
+        cmd.add_option("--variant", opts.variant,
+                       "How concurrent writes are resolved: colour (coloured scatter, deterministic), gather "
+                       "(pull through adjacency lists, deterministic), atomic (atomic adds) or private "
+                       "(per-thread accumulators + reduction)")
+            ->check(CLI::IsMember({"colour", "color", "gather", "atomic", "private"}))
+            ->each([&opts](const std::string&) { opts.variant_given = true; })
+            ->capture_default_str();
 }
 
 namespace {

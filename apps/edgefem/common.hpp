@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/executor.hpp"
 #include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh.hpp"
 #include "edgefem/core/read_mesh.hpp"
@@ -65,6 +66,25 @@ struct ModelOptions {
 // to the Material defaults (bench).
 void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required);
 
+// ---- Execution (parallel back-ends) ----------------------------------------
+
+struct ExecOptions {
+    std::string backend = "serial";  // serial | omp | tbb
+    int threads = 0;                 // 0: all hardware threads
+    std::string variant = "colour";  // colour | gather | atomic | private
+    bool variant_given = false;      // --variant on the command line
+
+    // The parallel kernels run unless this is the plain serial default
+    // (--backend serial without --variant: core's serial loops).
+    bool parallel_kernels() const { return backend != "serial" || variant_given; }
+    std::shared_ptr<const Executor> executor() const;
+    // "serial" or e.g. "tbb x2, colour".
+    std::string describe() const;
+};
+
+// Adds --backend, --threads and (with_variant) --variant.
+void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant = true);
+
 // The kernels `bench` times (see its --help).
 enum class Kernel { Force, Stiffness, ForceStiffness, Kx };
 
@@ -91,6 +111,9 @@ public:
 
 // Builds the chosen model for `mesh` (opts must be validated).
 std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts);
+// The same on the chosen back-end (parallel_evaluator.cpp); the serial
+// default gives the evaluator above.
+std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec);
 
 // ---- Text I/O -------------------------------------------------------------
 

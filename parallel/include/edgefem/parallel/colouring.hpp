@@ -1,0 +1,111 @@
+// Colourings for the coloured-scatter kernels, computed once per mesh.
+//
+// Items (edges, TSEP segments, tets) are grouped into units of `block`
+// consecutive items (block 1: every item is a unit); units are coloured so
+// that no two units of one colour write the same target ("resource"), so a
+// colour's units can run concurrently with plain (non-atomic) stores, and
+// each target is written at most once per colour. Colours run one after
+// another in a fixed order, which makes the result independent of the
+// thread count.
+//
+// Greedy first-fit in unit order, then one balancing pass that moves units
+// out of over-full colours into the least-used colour they may join
+// (Lu et al., "Balanced coloring for parallel computing applications", 2015).
+//
+// Each colour's units are split into chunks (the unit of work handed to a
+// thread) with fixed sizes that depend on the colour size only, never on the
+// thread count; chunk ids are global (chunk_first[c] + k) so that a kernel
+// can give each chunk its own scratch (the stiffness sink).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/tet_model.hpp"
+
+namespace edgefem {
+
+struct ColouringStats {
+    int colours = 0;
+    index_t items = 0;
+    index_t block = 1;          // items per unit
+    index_t min_units = 0;      // smallest colour, in units
+    index_t max_units = 0;      // largest colour, in units
+    double mean_units = 0;
+    index_t chunks = 0;         // total chunks over all colours
+    // "<colours> colours, units per colour min/mean/max = ..."
+    std::string describe() const;
+};
+
+struct Colouring {
+    index_t num_items = 0;
+    index_t block = 1;
+    std::vector<index_t> colour_first;  // #colours + 1, into units
+    std::vector<index_t> units;         // unit ids, ascending within a colour
+    std::vector<index_t> chunk_first;   // #colours + 1, global chunk ids
+    std::vector<index_t> chunk_units;   // #colours: units per chunk in colour c
+
+    int colours() const { return colour_first.empty() ? 0 : int(colour_first.size() - 1); }
+    index_t num_chunks() const { return chunk_first.empty() ? 0 : chunk_first.back(); }
+    // Items of unit u: [u * block, min(num_items, (u + 1) * block)).
+    index_t unit_begin(index_t u) const { return u * block; }
+    index_t unit_end(index_t u) const { return std::min(num_items, (u + 1) * block); }
+    ColouringStats stats() const;
+};
+
+// Appends the targets item i writes to `out` (duplicates allowed).
+using ResourceFn = std::function<void(index_t item, std::vector<index_t>& out)>;
+
+struct ColouringOptions {
+    index_t block = 1;        // items per unit
+    bool balance = true;      // run the balancing pass
+    // Chunking of each colour: about colour_size / chunks_per_colour units
+    // per chunk, at least min_chunk_items and at most max_chunk_items items.
+    index_t chunks_per_colour = 64;
+    index_t min_chunk_items = 16;
+    index_t max_chunk_items = 1024;
+};
+
+Colouring colour_items(index_t num_items, index_t num_resources, const ResourceFn& resources,
+                       const ColouringOptions& opts = {});
+
+// Number of (colour, resource) pairs written by more than one unit of that
+// colour: 0 for a valid colouring. Also checks every item appears once.
+// Returns -1 when the colouring does not cover the items exactly once.
+long colouring_conflicts(const Colouring& c, index_t num_resources, const ResourceFn& resources);
+
+// The write sets of the edge kernels' scatter loops (see edge_kernels.hpp).
+// Edge scatter (forces, K x, diagonal blocks): V0(E), V1(E).
+template <class S>
+ResourceFn edge_scatter_resources(const EdgeModel<S>& m);
+// TSEP strain segment e0: g(e0) and g(E1) for its TSEPs.
+template <class S>
+ResourceFn tsep_strain_resources(const EdgeModel<S>& m);
+// TSEP stiffness segment e0: K(E2) for the 4 targets of its TSEPs, the sink
+// (diagonal targets) excluded: the kernels give each chunk its own sink.
+template <class S>
+ResourceFn tsep_stiffness_resources(const EdgeModel<S>& m);
+// Per-tet scatter: the tet's 4 vertices.
+template <class S>
+ResourceFn tet_scatter_resources(const TetModel<S>& m);
+
+template <class S>
+Colouring colour_edges(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
+    return colour_items(m.num_edges(), m.num_vertices, edge_scatter_resources(m), opts);
+}
+template <class S>
+Colouring colour_tsep_strain(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
+    return colour_items(m.num_edges(), m.num_edges(), tsep_strain_resources(m), opts);
+}
+template <class S>
+Colouring colour_tsep_stiffness(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
+    return colour_items(m.num_edges(), m.num_edges(), tsep_stiffness_resources(m), opts);
+}
+template <class S>
+Colouring colour_tets(const TetModel<S>& m, const ColouringOptions& opts = {}) {
+    return colour_items(m.num_tets(), m.num_vertices, tet_scatter_resources(m), opts);
+}
+
+}  // namespace edgefem

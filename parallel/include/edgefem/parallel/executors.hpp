@@ -1,0 +1,70 @@
+// Executors that run core's chunked loops on threads: OpenMP (a parallel
+// for over the chunks) and oneTBB (a parallel_for inside a task_arena the
+// executor owns). Threads are created once (OpenMP's pool, the arena) and
+// reused by every call; the thread count is fixed per executor, so each
+// Simulator can have its own.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "edgefem/core/executor.hpp"
+
+namespace edgefem {
+
+enum class Backend { Serial, OpenMP, TBB };
+
+// How chunks are handed to threads. Results never depend on it (chunks are
+// fixed by the caller); it only changes load balance and overhead.
+enum class Schedule { Static, Dynamic };
+
+// "serial" | "omp" (or "openmp") | "tbb"; throws InvalidArgument otherwise.
+Backend parse_backend(std::string_view name);
+// "serial", "omp", "tbb".
+const char* to_string(Backend b);
+Schedule parse_schedule(std::string_view name);  // "static" | "dynamic"
+const char* to_string(Schedule s);
+
+class OmpExecutor final : public Executor {
+public:
+    // threads <= 0: omp_get_max_threads().
+    explicit OmpExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
+    int threads() const override { return threads_; }
+    const char* name() const override { return "omp"; }
+    Schedule schedule() const { return schedule_; }
+    void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
+
+private:
+    int threads_;
+    Schedule schedule_;
+};
+
+class TbbExecutor final : public Executor {
+public:
+    // threads <= 0: the default concurrency. TBB never runs more threads
+    // than its global limit (the hardware threads unless the application
+    // raises it with tbb::global_control): a larger count is accepted and
+    // splits the work the same way, on fewer threads.
+    explicit TbbExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
+    ~TbbExecutor() override;
+    int threads() const override { return threads_; }
+    const char* name() const override { return "tbb"; }
+    Schedule schedule() const { return schedule_; }
+    void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
+
+private:
+    struct Impl;
+    int threads_;
+    Schedule schedule_;
+    std::unique_ptr<Impl> impl_;
+};
+
+// Serial ignores `threads`.
+std::shared_ptr<const Executor> make_executor(Backend backend, int threads = 0,
+                                              Schedule schedule = Schedule::Dynamic);
+
+// Number of hardware threads available to this process.
+int hardware_threads();
+
+}  // namespace edgefem

@@ -1,0 +1,409 @@
+// The edge-based kernels of core (edge_kernels.hpp) run on an Executor.
+// Every formula is core's: the coloured and private variants run the plain
+// workers (kernel::edge_strain, tsep_strain_segment, edge_force,
+// edge_stiffness, tsep_stiffness_segment, edge_kx, edge_diagonal), the
+// gather and atomic variants the worker variants of
+// core/edge_kernel_variants.hpp. This class only decides which items run
+// where, and owns the per-mesh plan (colourings, gather lists, private
+// buffers). One object must not run two kernels at the same time.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <vector>
+
+#include "edgefem/core/edge_kernel_variants.hpp"
+#include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/executor.hpp"
+#include "edgefem/parallel/colouring.hpp"
+#include "edgefem/parallel/loops.hpp"
+#include "edgefem/parallel/variant.hpp"
+
+namespace edgefem {
+
+template <class S>
+class ParallelEdgeKernels {
+public:
+    ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<const Executor> executor, Variant variant,
+                        const PlanOptions& opts = {});
+
+    const EdgeModel<S>& model() const { return m_; }
+    const Executor& executor() const { return *ex_; }
+    Variant variant() const { return variant_; }
+
+    // K blocks: #E, then the sink block(s) (one per chunk of the coloured
+    // stiffness pass, one otherwise). Use resize() to size an EdgeStiffness.
+    index_t stiffness_blocks() const { return m_.num_edges() + num_sinks_; }
+    void resize(EdgeStiffness<S>& K) const { K.K.assign(9 * std::size_t(stiffness_blocks()), S(0)); }
+
+    // As edge_forces: f = dW/du (overwritten), W when Energy, state in st.
+    template <ModelKind Kind, bool Energy>
+    double forces(const S* u, S* f, EdgeState<S>& st) const;
+    // As edge_stiffness_all (K must have stiffness_blocks() blocks).
+    template <ModelKind Kind, bool Definite = false>
+    void stiffness(const EdgeState<S>& st, EdgeStiffness<S>& K) const;
+    // As edge_multiply / edge_diagonal_blocks.
+    void multiply(const EdgeStiffness<S>& K, const S* x, S* y) const;
+    void diagonal_blocks(const EdgeStiffness<S>& K, S* D) const;
+
+    // Colour variant only (empty otherwise).
+    const Colouring& edge_colouring() const { return edge_col_; }
+    const Colouring& tsep_colouring() const { return tsep_col_; }
+    const Colouring& stiffness_colouring() const { return stiff_col_; }
+    // Bytes of the plan (colour lists, gather lists; private buffers once allocated).
+    std::size_t plan_bytes() const;
+
+private:
+    template <class Body>
+    void each_range(index_t n, Body&& body) const {
+        par::for_range(*ex_, n, par::range_chunk(n, range_chunk_), body);
+    }
+    // Private variant: body(part, begin, end) over `parts` contiguous pieces of [0, n).
+    template <class Body>
+    void each_part(index_t n, Body&& body) const {
+        ex_->for_chunks(parts_, [&](index_t p) {
+            body(int(p), par::part_begin(n, parts_, int(p)), par::part_begin(n, parts_, int(p) + 1));
+        });
+    }
+    // out[i] (+)= sum over parts of buf[part * stride + i] for i < len, in
+    // part order; the buffers are re-zeroed for the next call.
+    template <class T, class U>
+    void reduce_parts(std::vector<U>& buf, std::size_t len, std::size_t stride, T* out, bool accumulate) const;
+    template <class T>
+    std::vector<T>& private_buffer(std::vector<T>& buf, std::size_t len) const {
+        if (buf.size() != len * std::size_t(parts_)) buf.assign(len * std::size_t(parts_), T(0));
+        return buf;
+    }
+
+    EdgeModel<S> m_;
+    std::shared_ptr<const Executor> ex_;
+    Variant variant_;
+    index_t range_chunk_;
+    int parts_ = 1;          // private accumulators
+    index_t num_sinks_ = 1;  // sink blocks after the #E edge blocks
+    Colouring edge_col_, tsep_col_, stiff_col_;
+    // Gather lists: vertex -> incident edges (side-encoded), edge -> incoming
+    // TSEPs (E0, L(P)), edge -> incoming stiffness contributions.
+    std::vector<index_t> inc_first_, inc_;
+    std::vector<index_t> tin_first_, tin_e0_;
+    std::vector<S> tin_L_;
+    std::vector<index_t> kin_first_;
+    std::vector<kernel::StiffnessSource> kin_;
+    // Private accumulators (allocated on first use).
+    mutable std::vector<S> pv_, pd_, pk_;
+    mutable std::vector<double> pg_;
+};
+
+// ---- Implementation -----------------------------------------------------------
+
+namespace par {
+template <class T>
+inline void atomic_add(T* base, std::size_t i, T v) {
+    std::atomic_ref<T>(base[i]).fetch_add(v, std::memory_order_relaxed);
+}
+}  // namespace par
+
+template <class S>
+ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<const Executor> executor,
+                                            Variant variant, const PlanOptions& opts)
+    : m_(std::move(model)),
+      ex_(executor ? std::move(executor) : std::make_shared<SerialExecutor>()),
+      variant_(variant),
+      range_chunk_(std::max<index_t>(1, opts.range_chunk)),
+      parts_(std::max(1, ex_->threads())) {
+    const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    switch (variant_) {
+        case Variant::Colour: {
+            edge_col_ = colour_edges(m_, opts.edge_colouring);
+            tsep_col_ = colour_tsep_strain(m_, opts.segment_colouring);
+            if (opts.stiffness && !m_.target.empty()) {
+                stiff_col_ = colour_tsep_stiffness(m_, opts.segment_colouring);
+                // Each chunk of the stiffness pass gets its own sink block, so
+                // concurrent chunks never write the same scratch.
+                num_sinks_ = std::max<index_t>(1, stiff_col_.num_chunks());
+                const index_t sink = ne << 1;
+                for (int c = 0; c < stiff_col_.colours(); ++c)
+                    for (index_t x = stiff_col_.colour_first[c]; x < stiff_col_.colour_first[c + 1]; ++x) {
+                        const index_t k = (x - stiff_col_.colour_first[c]) / stiff_col_.chunk_units[c];
+                        const index_t chunk = stiff_col_.chunk_first[c] + k;
+                        const index_t u = stiff_col_.units[x];
+                        for (index_t e0 = stiff_col_.unit_begin(u); e0 < stiff_col_.unit_end(u); ++e0)
+                            for (index_t P = m_.tsep_first[e0]; P < m_.tsep_first[e0 + 1]; ++P)
+                                for (auto& t : m_.target[P])
+                                    if (t == sink) t = (ne + chunk) << 1;
+                    }
+            }
+            break;
+        }
+        case Variant::Gather: {
+            inc_first_.assign(std::size_t(nv) + 1, 0);
+            for (const auto& e : m_.edge) {
+                ++inc_first_[e[0] + 1];
+                ++inc_first_[e[1] + 1];
+            }
+            for (index_t v = 0; v < nv; ++v) inc_first_[v + 1] += inc_first_[v];
+            inc_.resize(inc_first_.back());
+            std::vector<index_t> pos(inc_first_.begin(), inc_first_.end() - 1);
+            for (index_t e = 0; e < ne; ++e) {  // ascending edges per vertex
+                inc_[pos[m_.edge[e][0]]++] = e << 1;
+                inc_[pos[m_.edge[e][1]]++] = (e << 1) | 1;
+            }
+            const index_t np = m_.num_tseps();
+            tin_first_.assign(std::size_t(ne) + 1, 0);
+            for (index_t P = 0; P < np; ++P) ++tin_first_[m_.tsep_other[P] + 1];
+            for (index_t e = 0; e < ne; ++e) tin_first_[e + 1] += tin_first_[e];
+            tin_e0_.resize(np);
+            tin_L_.resize(np);
+            pos.assign(tin_first_.begin(), tin_first_.end() - 1);
+            for (index_t e0 = 0; e0 < ne; ++e0)  // ascending TSEPs per edge
+                for (index_t P = m_.tsep_first[e0]; P < m_.tsep_first[e0 + 1]; ++P) {
+                    const index_t at = pos[m_.tsep_other[P]]++;
+                    tin_e0_[at] = e0;
+                    tin_L_[at] = m_.LP[P];
+                }
+            if (opts.stiffness && !m_.target.empty()) {
+                kin_first_.assign(std::size_t(ne) + 1, 0);
+                for (index_t P = 0; P < np; ++P)
+                    for (int k = 0; k < 4; ++k)
+                        if ((m_.target[P][k] >> 1) < ne) ++kin_first_[(m_.target[P][k] >> 1) + 1];
+                for (index_t e = 0; e < ne; ++e) kin_first_[e + 1] += kin_first_[e];
+                kin_.resize(kin_first_.back());
+                pos.assign(kin_first_.begin(), kin_first_.end() - 1);
+                for (index_t e0 = 0; e0 < ne; ++e0)  // ascending (P, k) per target
+                    for (index_t P = m_.tsep_first[e0]; P < m_.tsep_first[e0 + 1]; ++P)
+                        for (int k = 0; k < 4; ++k) {
+                            const index_t t = m_.target[P][k];
+                            if ((t >> 1) >= ne) continue;
+                            kin_[pos[t >> 1]++] = {P, e0, std::uint8_t(k | ((t & 1) << 2))};
+                        }
+            }
+            break;
+        }
+        default: break;
+    }
+}
+
+template <class S>
+std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
+    auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+    std::size_t b = 0;
+    for (const Colouring* c : {&edge_col_, &tsep_col_, &stiff_col_})
+        b += bytes(c->units) + bytes(c->colour_first) + bytes(c->chunk_first) + bytes(c->chunk_units);
+    b += bytes(inc_first_) + bytes(inc_) + bytes(tin_first_) + bytes(tin_e0_) + bytes(tin_L_) + bytes(kin_first_) +
+         bytes(kin_);
+    b += bytes(pv_) + bytes(pd_) + bytes(pk_) + bytes(pg_);
+    return b;
+}
+
+template <class S>
+template <class T, class U>
+void ParallelEdgeKernels<S>::reduce_parts(std::vector<U>& buf, std::size_t len, std::size_t stride, T* out,
+                                          bool accumulate) const {
+    par::for_range(*ex_, index_t(len), par::range_chunk(index_t(len), range_chunk_), [&](index_t b, index_t e) {
+        for (index_t i = b; i < e; ++i) {
+            U s = accumulate ? U(out[i]) : U(0);
+            for (int p = 0; p < parts_; ++p) {
+                U& x = buf[std::size_t(p) * stride + i];
+                s += x;
+                x = U(0);
+            }
+            out[i] = T(s);
+        }
+    });
+}
+
+template <class S>
+template <ModelKind Kind, bool Energy>
+double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const {
+    const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    const std::size_t nf = 3 * std::size_t(nv);
+    st.resize(ne);
+    S* p = st.p.data();
+    S* zeta = st.zeta.data();
+    double* g = st.g.data();
+    const auto& m = m_;
+    each_range(ne, [&](index_t b, index_t e) {
+        for (index_t i = b; i < e; ++i) kernel::edge_strain(m, u, i, p, zeta, g);
+    });
+    if constexpr (Kind == ModelKind::FE) {
+        switch (variant_) {
+            case Variant::Colour:
+                par::for_colours(*ex_, tsep_col_, [&](index_t e0, index_t) { kernel::tsep_strain_segment(m, e0, zeta, g); });
+                break;
+            case Variant::Gather:
+                each_range(ne, [&](index_t b, index_t e) {
+                    for (index_t i = b; i < e; ++i)
+                        kernel::tsep_strain_gather(m, i, &tin_e0_[tin_first_[i]], &tin_L_[tin_first_[i]],
+                                                   tin_first_[i + 1] - tin_first_[i], zeta, g);
+                });
+                break;
+            case Variant::Atomic:
+                each_range(ne, [&](index_t b, index_t e) {
+                    for (index_t i = b; i < e; ++i)
+                        kernel::tsep_strain_segment_to(m, i, zeta, [g](std::size_t k, double v) { par::atomic_add(g, k, v); });
+                });
+                break;
+            case Variant::Private: {
+                auto& buf = private_buffer(pg_, ne);
+                each_part(ne, [&](int part, index_t b, index_t e) {
+                    double* gp = &buf[std::size_t(part) * ne];
+                    for (index_t i = b; i < e; ++i) kernel::tsep_strain_segment(m, i, zeta, gp);
+                });
+                reduce_parts(buf, ne, ne, g, true);
+                break;
+            }
+        }
+    }
+    switch (variant_) {
+        case Variant::Colour:
+            each_range(index_t(nf), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
+            par::for_colours(*ex_, edge_col_, [&](index_t e, index_t) { kernel::edge_force(m, e, p, g, f); });
+            break;
+        case Variant::Gather:
+            each_range(nv, [&](index_t b, index_t e) {
+                for (index_t v = b; v < e; ++v)
+                    kernel::vertex_force_gather(v, &inc_[inc_first_[v]], inc_first_[v + 1] - inc_first_[v], p, g, f);
+            });
+            break;
+        case Variant::Atomic:
+            each_range(index_t(nf), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
+            each_range(ne, [&](index_t b, index_t e) {
+                for (index_t i = b; i < e; ++i)
+                    kernel::edge_force_to(m, i, p, g, [f](std::size_t k, S v) { par::atomic_add(f, k, v); });
+            });
+            break;
+        case Variant::Private: {
+            auto& buf = private_buffer(pv_, nf);
+            each_part(ne, [&](int part, index_t b, index_t e) {
+                S* fp = &buf[std::size_t(part) * nf];
+                for (index_t i = b; i < e; ++i) kernel::edge_force(m, i, p, g, fp);
+            });
+            reduce_parts(buf, nf, nf, f, false);
+            break;
+        }
+    }
+    if constexpr (Energy)
+        return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
+    return 0;
+}
+
+template <class S>
+template <ModelKind Kind, bool Definite>
+void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>& Ks) const {
+    const index_t ne = m_.num_edges();
+    if (Ks.K.size() != 9 * std::size_t(stiffness_blocks())) resize(Ks);
+    const S* p = st.p.data();
+    const double* g = st.g.data();
+    S* K = Ks.K.data();
+    const auto& m = m_;
+    if (Kind == ModelKind::FE && variant_ == Variant::Gather) {  // one pass: K(E) = edge term + its TSEP terms
+        each_range(ne, [&](index_t b, index_t e) {
+            for (index_t i = b; i < e; ++i) {
+                kernel::edge_stiffness<Definite>(m, i, p, g, K);
+                kernel::tsep_stiffness_gather(m, i, &kin_[kin_first_[i]], kin_first_[i + 1] - kin_first_[i], p, K);
+            }
+        });
+        return;
+    }
+    each_range(ne, [&](index_t b, index_t e) {
+        for (index_t i = b; i < e; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
+    });
+    if constexpr (Kind == ModelKind::FE) {
+        switch (variant_) {
+            case Variant::Colour:
+                par::for_colours(*ex_, stiff_col_, [&](index_t e0, index_t) { kernel::tsep_stiffness_segment(m, e0, p, K); });
+                break;
+            case Variant::Atomic:
+                each_range(ne, [&](index_t b, index_t e) {
+                    for (index_t i = b; i < e; ++i)
+                        kernel::tsep_stiffness_segment_to(m, i, p, [K](std::size_t k, S v) { par::atomic_add(K, k, v); });
+                });
+                break;
+            case Variant::Private: {
+                const std::size_t len = 9 * (std::size_t(ne) + 1);
+                auto& buf = private_buffer(pk_, len);
+                each_part(ne, [&](int part, index_t b, index_t e) {
+                    S* kp = &buf[std::size_t(part) * len];
+                    for (index_t i = b; i < e; ++i) kernel::tsep_stiffness_segment(m, i, p, kp);
+                });
+                reduce_parts(buf, 9 * std::size_t(ne), len, K, true);  // the sink is not reduced
+                break;
+            }
+            default: break;
+        }
+    }
+}
+
+template <class S>
+void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S* y) const {
+    const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    const std::size_t ny = 3 * std::size_t(nv);
+    const S* K = Ks.K.data();
+    const auto& m = m_;
+    switch (variant_) {
+        case Variant::Colour:
+            each_range(index_t(ny), [&](index_t b, index_t e) { std::fill(y + b, y + e, S(0)); });
+            par::for_colours(*ex_, edge_col_, [&](index_t e, index_t) { kernel::edge_kx(m, e, K, x, y); });
+            break;
+        case Variant::Gather:
+            each_range(nv, [&](index_t b, index_t e) {
+                for (index_t v = b; v < e; ++v)
+                    kernel::vertex_kx_gather(m, v, &inc_[inc_first_[v]], inc_first_[v + 1] - inc_first_[v], K, x, y);
+            });
+            break;
+        case Variant::Atomic:
+            each_range(index_t(ny), [&](index_t b, index_t e) { std::fill(y + b, y + e, S(0)); });
+            each_range(ne, [&](index_t b, index_t e) {
+                for (index_t i = b; i < e; ++i)
+                    kernel::edge_kx_to(m, i, K, x, [y](std::size_t k, S v) { par::atomic_add(y, k, v); });
+            });
+            break;
+        case Variant::Private: {
+            auto& buf = private_buffer(pv_, ny);
+            each_part(ne, [&](int part, index_t b, index_t e) {
+                S* yp = &buf[std::size_t(part) * ny];
+                for (index_t i = b; i < e; ++i) kernel::edge_kx(m, i, K, x, yp);
+            });
+            reduce_parts(buf, ny, ny, y, false);
+            break;
+        }
+    }
+}
+
+template <class S>
+void ParallelEdgeKernels<S>::diagonal_blocks(const EdgeStiffness<S>& Ks, S* D) const {
+    const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    const std::size_t nd = 9 * std::size_t(nv);
+    const S* K = Ks.K.data();
+    const auto& m = m_;
+    switch (variant_) {
+        case Variant::Colour:
+            each_range(index_t(nd), [&](index_t b, index_t e) { std::fill(D + b, D + e, S(0)); });
+            par::for_colours(*ex_, edge_col_, [&](index_t e, index_t) { kernel::edge_diagonal(m, e, K, D); });
+            break;
+        case Variant::Gather:
+            each_range(nv, [&](index_t b, index_t e) {
+                for (index_t v = b; v < e; ++v)
+                    kernel::vertex_diagonal_gather(v, &inc_[inc_first_[v]], inc_first_[v + 1] - inc_first_[v], K, D);
+            });
+            break;
+        case Variant::Atomic:
+            each_range(index_t(nd), [&](index_t b, index_t e) { std::fill(D + b, D + e, S(0)); });
+            each_range(ne, [&](index_t b, index_t e) {
+                for (index_t i = b; i < e; ++i)
+                    kernel::edge_diagonal_to(m, i, K, [D](std::size_t k, S v) { par::atomic_add(D, k, v); });
+            });
+            break;
+        case Variant::Private: {
+            auto& buf = private_buffer(pd_, nd);
+            each_part(ne, [&](int part, index_t b, index_t e) {
+                S* dp = &buf[std::size_t(part) * nd];
+                for (index_t i = b; i < e; ++i) kernel::edge_diagonal(m, i, K, dp);
+            });
+            reduce_parts(buf, nd, nd, D, false);
+            break;
+        }
+    }
+}
+
+}  // namespace edgefem

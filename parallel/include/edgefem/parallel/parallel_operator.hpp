@@ -1,0 +1,45 @@
+// Elastic operators whose kernels run on an Executor, for the Simulator:
+//
+//   auto ex = make_executor(Backend::TBB, 2);
+//   Simulator<double> sim(scene, ex, parallel_operator_factory<double>(ex, Variant::Colour));
+//
+// The executor runs the CG vector operations, the factory's operators run
+// forces, stiffness, K x, diagonal blocks and the inverted-tet count on the
+// same executor. Colour and gather give bitwise the same step for any thread
+// count.
+#pragma once
+
+#include <memory>
+
+#include "edgefem/core/elastic_operator.hpp"
+#include "edgefem/core/executor.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/colouring.hpp"
+#include "edgefem/parallel/variant.hpp"
+
+namespace edgefem {
+
+template <class S>
+OperatorFactory<S> parallel_operator_factory(std::shared_ptr<const Executor> executor, Variant variant = Variant::Colour,
+                                             PlanOptions opts = {});
+
+// Direct construction (what the factory calls).
+template <class S>
+std::unique_ptr<ElasticOperator<S>> make_parallel_operator(const Mesh& mesh, const Materials& materials, ModelKind model,
+                                                           Method method, std::shared_ptr<const Executor> executor,
+                                                           Variant variant = Variant::Colour,
+                                                           const PlanOptions& opts = {});
+
+// Tets with non-positive deformed volume, counted on the executor (blocked,
+// so the count is exact for any thread count).
+template <class S>
+index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const S* u);
+
+// Colour counts of the edge method's colourings for a mesh (for `edgefem
+// info` and the docs).
+struct ColouringReport {
+    ColouringStats edges, tsep_strain, tsep_stiffness, tets;
+};
+ColouringReport colouring_report(const Mesh& mesh, const PlanOptions& opts = {});
+
+}  // namespace edgefem

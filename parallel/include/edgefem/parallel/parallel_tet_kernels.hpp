@@ -1,0 +1,140 @@
+// The per-tet kernels of core (tet_kernels.hpp) run on an Executor: the
+// stiffness is per tet (no conflicts); forces and K x scatter to the 4
+// vertices of each tet, coloured (tets of one colour share no vertex) or
+// into private accumulators. The per-tet method has no gather or atomic
+// workers in core: those variants run coloured (variant() says which runs).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "edgefem/core/executor.hpp"
+#include "edgefem/core/tet_kernels.hpp"
+#include "edgefem/parallel/colouring.hpp"
+#include "edgefem/parallel/loops.hpp"
+#include "edgefem/parallel/variant.hpp"
+
+namespace edgefem {
+
+template <class S>
+class ParallelTetKernels {
+public:
+    ParallelTetKernels(TetModel<S> model, std::shared_ptr<const Executor> executor, Variant variant,
+                       const PlanOptions& opts = {})
+        : m_(std::move(model)),
+          ex_(executor ? std::move(executor) : std::make_shared<SerialExecutor>()),
+          variant_(variant == Variant::Private ? Variant::Private : Variant::Colour),
+          range_chunk_(std::max<index_t>(1, opts.range_chunk)),
+          parts_(std::max(1, ex_->threads())) {
+        if (variant_ == Variant::Colour) {
+            col_ = colour_tets(m_, opts.tet_colouring);
+            partial_.resize(col_.num_chunks());
+        }
+    }
+
+    const TetModel<S>& model() const { return m_; }
+    Variant variant() const { return variant_; }
+    const Colouring& colouring() const { return col_; }
+
+    // As tet_forces (energy summed per chunk, chunks in a fixed order).
+    template <bool Energy>
+    double forces(const S* u, S* f) const {
+        const std::size_t nf = 3 * std::size_t(m_.num_vertices);
+        const auto& m = m_;
+        if (variant_ == Variant::Colour) {
+            par::for_range(*ex_, index_t(nf), par::range_chunk(index_t(nf), range_chunk_), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
+            std::fill(partial_.begin(), partial_.end(), 0.0);
+            par::for_colours(*ex_, col_, [&](index_t t, index_t chunk) {
+                const S w = kernel::tet_force(m, t, u, f);
+                if constexpr (Energy) partial_[chunk] += double(w);
+            });
+            double W = 0;
+            if constexpr (Energy)
+                for (double x : partial_) W += x;
+            return W;
+        }
+        if (pf_.size() != nf * parts_) pf_.assign(nf * parts_, S(0));
+        std::vector<double> part_energy(parts_, 0.0);
+        ex_->for_chunks(parts_, [&](index_t p) {
+            S* fp = &pf_[std::size_t(p) * nf];
+            double W = 0;
+            for (index_t t = par::part_begin(m.num_tets(), parts_, p); t < par::part_begin(m.num_tets(), parts_, p + 1); ++t) {
+                const S w = kernel::tet_force(m, t, u, fp);
+                if constexpr (Energy) W += double(w);
+            }
+            part_energy[p] = W;
+        });
+        reduce(pf_, nf, f);
+        double W = 0;
+        for (double x : part_energy) W += x;
+        return W;
+    }
+
+    // As tet_stiffness_all.
+    void stiffness(const S* u, TetStiffness<S>& K) const {
+        K.K.resize(90 * std::size_t(m_.num_tets()));
+        const auto& m = m_;
+        par::for_range(*ex_, m.num_tets(), par::range_chunk(m.num_tets(), range_chunk_ / 8 + 1), [&](index_t b, index_t e) {
+            for (index_t t = b; t < e; ++t) kernel::tet_stiffness(m, t, u, &K.K[90 * std::size_t(t)]);
+        });
+    }
+
+    // As tet_multiply.
+    void multiply(const TetStiffness<S>& K, const S* x, S* y) const {
+        scatter(3, y, [&](index_t t, S* out) { kernel::tet_kx(m_, t, &K.K[90 * std::size_t(t)], x, out); });
+    }
+
+    // The 3x3 diagonal blocks of K (9 #V): the sum of the tets' (a, a) blocks.
+    void diagonal_blocks(const TetStiffness<S>& K, S* D) const {
+        scatter(9, D, [&](index_t t, S* out) {
+            for (int a = 0; a < 4; ++a) {
+                const S* blk = &K.K[90 * std::size_t(t) + 9 * tet_block_index(a, a)];
+                S* d = &out[9 * std::size_t(m_.tet[t][a])];
+                for (int i = 0; i < 9; ++i) d[i] += blk[i];
+            }
+        });
+    }
+
+private:
+    // out = sum over tets of body(t, out) with `per` values per vertex.
+    template <class Body>
+    void scatter(int per, S* out, Body&& body) const {
+        const std::size_t n = per * std::size_t(m_.num_vertices);
+        if (variant_ == Variant::Colour) {
+            par::for_range(*ex_, index_t(n), par::range_chunk(index_t(n), range_chunk_), [&](index_t b, index_t e) { std::fill(out + b, out + e, S(0)); });
+            par::for_colours(*ex_, col_, [&](index_t t, index_t) { body(t, out); });
+            return;
+        }
+        std::vector<S>& buf = per == 3 ? pf_ : pd_;
+        if (buf.size() != n * parts_) buf.assign(n * parts_, S(0));
+        ex_->for_chunks(parts_, [&](index_t p) {
+            S* op = &buf[std::size_t(p) * n];
+            for (index_t t = par::part_begin(m_.num_tets(), parts_, p); t < par::part_begin(m_.num_tets(), parts_, p + 1); ++t)
+                body(t, op);
+        });
+        reduce(buf, n, out);
+    }
+    void reduce(std::vector<S>& buf, std::size_t n, S* out) const {
+        par::for_range(*ex_, index_t(n), par::range_chunk(index_t(n), range_chunk_), [&](index_t b, index_t e) {
+            for (index_t i = b; i < e; ++i) {
+                S s = 0;
+                for (int p = 0; p < parts_; ++p) {
+                    s += buf[std::size_t(p) * n + i];
+                    buf[std::size_t(p) * n + i] = S(0);
+                }
+                out[i] = s;
+            }
+        });
+    }
+
+    TetModel<S> m_;
+    std::shared_ptr<const Executor> ex_;
+    Variant variant_;
+    index_t range_chunk_;
+    int parts_;
+    Colouring col_;
+    mutable std::vector<double> partial_;
+    mutable std::vector<S> pf_, pd_;
+};
+
+}  // namespace edgefem

@@ -1,0 +1,31 @@
+// How a parallel kernel resolves concurrent writes to one target.
+#pragma once
+
+#include <string_view>
+
+#include "edgefem/parallel/colouring.hpp"
+
+namespace edgefem {
+
+enum class Variant {
+    Colour,   // coloured scatter: colours in a fixed order, plain stores (deterministic)
+    Gather,   // pull: each target sums its sources via CSR lists (deterministic)
+    Atomic,   // scatter with std::atomic_ref fetch_add (order varies run to run)
+    Private,  // one accumulator per thread part, then a parallel blocked reduction
+};
+
+// "colour" (or "color") | "gather" | "atomic" | "private"; throws InvalidArgument.
+Variant parse_variant(std::string_view name);
+const char* to_string(Variant v);
+// True for the variants whose results are bitwise independent of the thread count.
+inline bool is_deterministic(Variant v) { return v == Variant::Colour || v == Variant::Gather; }
+
+struct PlanOptions {
+    ColouringOptions edge_colouring;     // edge scatter (forces, K x, diagonal)
+    ColouringOptions segment_colouring;  // TSEP segments (g, K)
+    ColouringOptions tet_colouring;      // per-tet scatter
+    index_t range_chunk = 2048;          // items per chunk of the uncoloured loops
+    bool stiffness = true;               // build what the stiffness kernels need
+};
+
+}  // namespace edgefem

@@ -1,0 +1,112 @@
+#include "edgefem/parallel/executors.hpp"
+
+#include <omp.h>
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/partitioner.h>
+#include <oneapi/tbb/task_arena.h>
+#include <thread>
+
+#include "edgefem/core/error.hpp"
+
+namespace edgefem {
+
+Backend parse_backend(std::string_view name) {
+    if (name == "serial") return Backend::Serial;
+    if (name == "omp" || name == "openmp") return Backend::OpenMP;
+    if (name == "tbb") return Backend::TBB;
+    throw InvalidArgument("unknown backend '" + std::string(name) + "' (expected serial, omp or tbb)");
+}
+
+const char* to_string(Backend b) {
+    switch (b) {
+        case Backend::Serial: return "serial";
+        case Backend::OpenMP: return "omp";
+        default: return "tbb";
+    }
+}
+
+Schedule parse_schedule(std::string_view name) {
+    if (name == "static") return Schedule::Static;
+    if (name == "dynamic") return Schedule::Dynamic;
+    throw InvalidArgument("unknown schedule '" + std::string(name) + "' (expected static or dynamic)");
+}
+
+const char* to_string(Schedule s) { return s == Schedule::Static ? "static" : "dynamic"; }
+
+int hardware_threads() {
+    const unsigned n = std::thread::hardware_concurrency();
+    return n > 0 ? int(n) : 1;
+}
+
+// ---- OpenMP ---------------------------------------------------------------
+
+OmpExecutor::OmpExecutor(int threads, Schedule schedule)
+    : threads_(threads > 0 ? threads : omp_get_max_threads()), schedule_(schedule) {}
+
+void OmpExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const {
+    if (n <= 0) return;
+    if (n == 1 || threads_ == 1) {  // no parallel region for nothing to share
+        for (index_t c = 0; c < n; ++c) body(c);
+        return;
+    }
+    const int t = std::min<index_t>(threads_, n);
+    if (schedule_ == Schedule::Static) {
+#pragma omp parallel for num_threads(t) schedule(static)
+        for (index_t c = 0; c < n; ++c) body(c);
+    } else {
+#pragma omp parallel for num_threads(t) schedule(dynamic, 1)
+        for (index_t c = 0; c < n; ++c) body(c);
+    }
+}
+
+// ---- TBB --------------------------------------------------------------------
+
+struct TbbExecutor::Impl {
+    tbb::task_arena arena;
+    explicit Impl(int threads) {
+        // TBB runs at most its global limit of threads anyway; asking for
+        // more only prints a warning. The chunks (and so the results) do not
+        // depend on it.
+        arena.initialize(std::min(threads, tbb::info::default_concurrency()));
+    }
+};
+
+TbbExecutor::TbbExecutor(int threads, Schedule schedule)
+    : threads_(threads > 0 ? threads : tbb::info::default_concurrency()),
+      schedule_(schedule),
+      impl_(std::make_unique<Impl>(threads_)) {}
+
+TbbExecutor::~TbbExecutor() = default;
+
+void TbbExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const {
+    if (n <= 0) return;
+    if (n == 1 || threads_ == 1) {
+        for (index_t c = 0; c < n; ++c) body(c);
+        return;
+    }
+    const tbb::blocked_range<index_t> range(0, n, 1);
+    const auto run = [&](const tbb::blocked_range<index_t>& r) {
+        for (index_t c = r.begin(); c < r.end(); ++c) body(c);
+    };
+    impl_->arena.execute([&] {
+        if (schedule_ == Schedule::Static)
+            tbb::parallel_for(range, run, tbb::static_partitioner());
+        else
+            tbb::parallel_for(range, run, tbb::simple_partitioner());
+    });
+}
+
+// ---- Factory ------------------------------------------------------------------
+
+std::shared_ptr<const Executor> make_executor(Backend backend, int threads, Schedule schedule) {
+    switch (backend) {
+        case Backend::Serial: return std::make_shared<SerialExecutor>();
+        case Backend::OpenMP: return std::make_shared<OmpExecutor>(threads, schedule);
+        default: return std::make_shared<TbbExecutor>(threads, schedule);
+    }
+}
+
+}  // namespace edgefem

@@ -1,0 +1,108 @@
+// A whole semi-implicit Simulator step on the parallel back-ends (the
+// executor runs the CG vector operations, the operator factory the
+// kernels): colour and gather bitwise the same for any thread count and
+// equal to their SerialExecutor run; atomic and private close to it; every
+// variant close to the core's serial Simulator.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "edgefem/core/make_box.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/executors.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
+#include "models.hpp"
+
+using namespace edgefem;
+using edgefem::test::rel_diff;
+
+namespace {
+
+Scene cantilever(Method method) {
+    Scene s;
+    s.mesh = make_box(8, 3, 3);
+    s.materials = Material{2e4, 0.3, 1000};
+    s.gravity = {0, 0, -9.81};
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+        if (s.mesh.X[3 * v] < -0.04 + 1e-9) s.fixed.push_back(v);
+    s.integrator = Integrator::SemiImplicit;
+    s.method = method;
+    s.dt = 2e-3;
+    s.solver.cg_tolerance = 1e-10;
+    s.solver.cg_max_iterations = 2000;
+    s.count_inverted_tets = true;
+    return s;
+}
+
+struct Result {
+    std::vector<double> u, v;
+    int iterations = 0;
+    double elastic = 0;
+};
+
+Result run(Method method, std::shared_ptr<const Executor> ex, OperatorFactory<double> factory) {
+    Simulator<double> sim(cantilever(method), ex, std::move(factory));
+    Result r;
+    for (int k = 0; k < 4; ++k) r.iterations += sim.step().solver_iterations;
+    r.u.assign(sim.displacement().begin(), sim.displacement().end());
+    r.v.assign(sim.velocity().begin(), sim.velocity().end());
+    r.elastic = sim.energies().elastic;
+    return r;
+}
+
+bool same(const std::vector<double>& a, const std::vector<double>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
+    for (Method method : {Method::Edge, Method::Tet}) {
+        const Result core = run(method, nullptr, {});
+        EXPECT_GT(edgefem::test::max_abs(core.u), 0);
+        for (Variant var : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private}) {
+            const auto serial_ex = std::make_shared<SerialExecutor>();
+            const Result serial = run(method, serial_ex, parallel_operator_factory<double>(serial_ex, var));
+            const std::string tag = std::string(method == Method::Edge ? "edge/" : "tet/") + to_string(var);
+            EXPECT_LE(rel_diff(serial.u, core.u), 1e-12) << tag;
+            EXPECT_LE(rel_diff(serial.v, core.v), 1e-12) << tag;
+            for (Backend b : {Backend::OpenMP, Backend::TBB})
+                for (int t : {1, 2, 3, 4, 8}) {
+                    const auto ex = make_executor(b, t);
+                    const Result par = run(method, ex, parallel_operator_factory<double>(ex, var));
+                    const std::string where = tag + "/" + to_string(b) + "-" + std::to_string(t);
+                    if (is_deterministic(var) || (method == Method::Tet && var != Variant::Private)) {
+                        EXPECT_TRUE(same(par.u, serial.u)) << where << " " << rel_diff(par.u, serial.u);
+                        EXPECT_TRUE(same(par.v, serial.v)) << where;
+                        EXPECT_EQ(par.iterations, serial.iterations) << where;
+                        EXPECT_EQ(par.elastic, serial.elastic) << where;
+                    } else {
+                        EXPECT_LE(rel_diff(par.u, serial.u), 1e-12) << where;
+                        EXPECT_LE(rel_diff(par.v, serial.v), 1e-12) << where;
+                    }
+                }
+        }
+    }
+}
+
+TEST(ParallelSimulator, InvertedTetCount) {
+    Scene s = cantilever(Method::Edge);
+    const auto ex = make_executor(Backend::TBB, 3);
+    std::vector<double> u(s.mesh.X.size(), 0.0);
+    // Collapse a few vertices onto the origin: inverts or flattens some tets.
+    for (int v = 0; v < 20; ++v)
+        for (int r = 0; r < 3; ++r) u[3 * v + r] = -s.mesh.X[3 * v + r] + (r == 0 ? 0.05 : 0);
+    std::size_t serial = 0;
+    for (index_t t = 0; t < s.mesh.num_tets(); ++t) {
+        double x[4][3];
+        for (int k = 0; k < 4; ++k)
+            for (int r = 0; r < 3; ++r) {
+                const index_t v = s.mesh.tets[4 * t + k];
+                x[k][r] = s.mesh.X[3 * v + r] + u[3 * v + r];
+            }
+        serial += signed_volume(x[0], x[1], x[2], x[3]) <= 0;
+    }
+    EXPECT_GT(serial, 0u);
+    EXPECT_EQ(count_inverted_tets_parallel(*ex, s.mesh, u.data()), index_t(serial));
+}
