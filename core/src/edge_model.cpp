@@ -4,7 +4,7 @@ namespace edgefem {
 
 template <class S>
 double EdgeModel<S>::bytes_per_tet(bool with_stiffness) const {
-    const double bytes = edge.size() * sizeof(edge[0]) + rest.size() * sizeof(S) + LE.size() * sizeof(S) +
+    const double bytes = edge.size() * sizeof(edge[0]) + edge_first.size() * sizeof(index_t) + rest.size() * sizeof(S) + LE.size() * sizeof(S) +
                          tsep_first.size() * sizeof(index_t) + tsep_other.size() * sizeof(index_t) + LP.size() * sizeof(S) +
                          (with_stiffness ? target.size() * sizeof(target[0]) : 0);
     return num_tets > 0 ? bytes / num_tets : 0.0;
@@ -16,6 +16,7 @@ EdgeModel<S> make_edge_model(const Topology& topo, const Coefficients& coef) {
     m.num_vertices = topo.num_vertices;
     m.num_tets = topo.num_tets;
     m.edge = topo.edges;
+    m.edge_first = topo.first_edge;
     m.rest.assign(coef.rest_edge.begin(), coef.rest_edge.end());
     m.LE.assign(coef.LE.begin(), coef.LE.end());
     m.tsep_first = topo.first_tsep;

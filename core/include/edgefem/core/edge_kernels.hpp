@@ -85,6 +85,29 @@ inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, 
     }
 }
 
+// Edge scatter over the segment of edges whose V0 is `a`: f(a) gets the
+// segment's sum from registers (edges are sorted by V0, so a per-edge
+// f(V0) += ... would chain stores to one address); each f(V1) -= p~ g.
+template <class S>
+inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
+                               S* __restrict f) {
+    S acc0 = 0, acc1 = 0, acc2 = 0;
+    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
+        const index_t b = m.edge[e][1];
+        const S ge = S(g[e]);
+        const S v0 = p[3 * std::size_t(e)] * ge, v1 = p[3 * std::size_t(e) + 1] * ge, v2 = p[3 * std::size_t(e) + 2] * ge;
+        acc0 += v0;
+        acc1 += v1;
+        acc2 += v2;
+        f[3 * std::size_t(b)] -= v0;
+        f[3 * std::size_t(b) + 1] -= v1;
+        f[3 * std::size_t(b) + 2] -= v2;
+    }
+    f[3 * std::size_t(a)] += acc0;
+    f[3 * std::size_t(a) + 1] += acc1;
+    f[3 * std::size_t(a) + 2] += acc2;
+}
+
 // Edge term of the stiffness: K(E) = -g I - 2 L(E) p~ p~^T (overwrites).
 // `Definite` uses max(g, 0) instead of g: the Hessian is J^T A J (positive
 // semi-definite) plus the edge Laplacian weighted by g, so only edges with
@@ -142,6 +165,29 @@ inline void edge_kx(const EdgeModel<S>& m, index_t e, const S* __restrict K, con
     }
 }
 
+// K x over the segment of edges whose V0 is `a` (y(a) accumulated in
+// registers, as in edge_force_segment).
+template <class S>
+inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
+                            S* __restrict y) {
+    const S xa0 = x[3 * std::size_t(a)], xa1 = x[3 * std::size_t(a) + 1], xa2 = x[3 * std::size_t(a) + 2];
+    S acc0 = 0, acc1 = 0, acc2 = 0;
+    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
+        const index_t b = m.edge[e][1];
+        const S* k = &K[9 * std::size_t(e)];
+        const S d0 = xa0 - x[3 * std::size_t(b)], d1 = xa1 - x[3 * std::size_t(b) + 1], d2 = xa2 - x[3 * std::size_t(b) + 2];
+        acc0 += k[0] * d0 + k[1] * d1 + k[2] * d2;
+        acc1 += k[3] * d0 + k[4] * d1 + k[5] * d2;
+        acc2 += k[6] * d0 + k[7] * d1 + k[8] * d2;
+        y[3 * std::size_t(b)] += k[0] * d0 + k[3] * d1 + k[6] * d2;
+        y[3 * std::size_t(b) + 1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
+        y[3 * std::size_t(b) + 2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
+    }
+    y[3 * std::size_t(a)] -= acc0;
+    y[3 * std::size_t(a) + 1] -= acc1;
+    y[3 * std::size_t(a) + 2] -= acc2;
+}
+
 // Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
 template <class S>
 inline void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict K, S* __restrict D) {
@@ -169,11 +215,10 @@ double edge_forces(const EdgeModel<S>& m, const S* u, S* f, EdgeState<S>& st) {
     if constexpr (Kind == ModelKind::FE)
         for (index_t e = 0; e < ne; ++e) kernel::tsep_strain_segment(m, e, st.zeta.data(), st.g.data());
     std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
+    for (index_t a = 0; a < m.num_vertices; ++a) kernel::edge_force_segment(m, a, st.p.data(), st.g.data(), f);
     double W = 0;
-    for (index_t e = 0; e < ne; ++e) {
-        kernel::edge_force(m, e, st.p.data(), st.g.data(), f);
-        if constexpr (Energy) W += double(st.zeta[e]) * double(st.g[e]);
-    }
+    if constexpr (Energy)
+        for (index_t e = 0; e < ne; ++e) W += double(st.zeta[e]) * st.g[e];
     return 0.25 * W;
 }
 
@@ -192,7 +237,7 @@ void edge_stiffness_all(const EdgeModel<S>& m, const EdgeState<S>& st, EdgeStiff
 template <class S>
 void edge_multiply(const EdgeModel<S>& m, const EdgeStiffness<S>& K, const S* x, S* y) {
     std::fill(y, y + 3 * std::size_t(m.num_vertices), S(0));
-    for (index_t e = 0; e < m.num_edges(); ++e) kernel::edge_kx(m, e, K.K.data(), x, y);
+    for (index_t a = 0; a < m.num_vertices; ++a) kernel::edge_kx_segment(m, a, K.K.data(), x, y);
 }
 
 // The 3x3 diagonal blocks of K (9 #V, row-major, overwritten).

@@ -21,7 +21,10 @@ template <class S>
 struct EdgeModel {
     index_t num_vertices = 0;
     index_t num_tets = 0;
-    std::vector<std::array<index_t, 2>> edge;  // #E {V0, V1}
+    std::vector<std::array<index_t, 2>> edge;  // #E {V0, V1}, sorted by V0
+    // Edges with V0 = v are edge_first[v] .. edge_first[v+1]: the scatter
+    // loops accumulate f(V0) over such a segment in registers.
+    std::vector<index_t> edge_first;           // #V + 1
     std::vector<S> rest;                       // 3 #E rest edge vectors X(V0) - X(V1)
     std::vector<S> LE;                         // #E L(E)
     // TSEPs are held in segments by their first edge E0 (they are sorted by
