@@ -92,9 +92,7 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     scene.solver.cg_tolerance = 1e-6;
     scene.solver.cg_fixed_iterations = opts.cg_iters;
     const auto ex = opts.exec.executor();
-    Simulator<S> sim(std::move(scene), ex,
-                     opts.exec.parallel_kernels() ? parallel_operator_factory<S>(ex, parse_variant(opts.exec.variant))
-                                                  : OperatorFactory<S>{});
+    Simulator<S> sim(std::move(scene), ex, operator_factory<S>(opts.exec, ex));
 
     std::vector<int> iterations;  // of every call, warm-up included
     const std::vector<double> ns = time_calls(opts.seconds, [&] { iterations.push_back(sim.step().solver_iterations); });

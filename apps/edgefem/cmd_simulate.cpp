@@ -23,6 +23,7 @@ struct SimulateOptions {
     std::string scene;  // empty: the built-in default
     std::string out;    // overrides output.dir
     int steps = -1;     // >= 0 overrides the scene's steps
+    ExecOptions exec;
 };
 
 double median(std::vector<double> v) {
@@ -76,7 +77,8 @@ void run_simulate(const SimulateOptions& opts) {
     const OutputSettings out = sf.output;
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
-    Simulator<double> sim(std::move(sf.scene));
+    const auto executor = opts.exec.executor();
+    Simulator<double> sim(std::move(sf.scene), executor, operator_factory<double>(opts.exec, executor));
     const Scene& scene = sim.scene();
     const long steps = scene.steps;
 
@@ -171,6 +173,7 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--steps", opts->steps, "Number of steps (overrides the scene's steps)")
         ->check(CLI::NonNegativeNumber);
     cmd->footer(kExitCodesHelp);
+    add_exec_options(*cmd, opts->exec);
     cmd->callback([opts] { run_simulate(*opts); });
 }
 

@@ -13,12 +13,14 @@ namespace {
 
 struct StaticOptions {
     std::string scene, out;
+    ExecOptions exec;
 };
 
 void run_static(const StaticOptions& opts) {
     const auto t0 = std::chrono::steady_clock::now();
     SceneFile sf = load_scene_file(opts.scene);
-    Simulator<double> sim(std::move(sf.scene));
+    const auto executor = opts.exec.executor();
+    Simulator<double> sim(std::move(sf.scene), executor, operator_factory<double>(opts.exec, executor));
     const StaticResult r = sim.solve_static();
 
     const auto u = sim.displacement();
@@ -50,6 +52,7 @@ void add_static_command(CLI::App& app) {
     cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md)")->required();
     cmd->add_option("--out", opts->out, "Output file prefix")->required();
     cmd->footer(kExitCodesHelp);
+    add_exec_options(*cmd, opts->exec);
     cmd->callback([opts] { run_static(*opts); });
 }
 

@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/simulator.hpp"
 #include "edgefem/core/executor.hpp"
 #include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh.hpp"
@@ -84,6 +85,11 @@ struct ExecOptions {
 
 // Adds --backend, --threads and (with_variant) --variant.
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant = true);
+
+// The elastic-model factory a simulator should use under `exec` (empty for
+// core's serial kernels), running on `executor`.
+template <class S>
+OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor);
 
 // The kernels `bench` times (see its --help).
 enum class Kernel { Force, Stiffness, ForceStiffness, Kx };

@@ -7,6 +7,7 @@
 #include "edgefem/core/topology.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_edge_kernels.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
 #include "edgefem/parallel/parallel_tet_kernels.hpp"
 
 namespace edgefem::cli {
@@ -145,5 +146,14 @@ std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& 
     if (opts.precision_kind() == Precision::Float) return make_parallel_as<float>(mesh, opts, exec);
     return make_parallel_as<double>(mesh, opts, exec);
 }
+
+template <class S>
+OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor) {
+    if (!exec.parallel_kernels()) return {};
+    return parallel_operator_factory<S>(executor, parse_variant(exec.variant));
+}
+
+template OperatorFactory<double> operator_factory<double>(const ExecOptions&, const std::shared_ptr<const Executor>&);
+template OperatorFactory<float> operator_factory<float>(const ExecOptions&, const std::shared_ptr<const Executor>&);
 
 }  // namespace edgefem::cli
