@@ -22,7 +22,7 @@ struct ForcesOptions {
 void run_forces(const ForcesOptions& opts) {
     opts.model.validate();
     const LoadedMesh lm = load_mesh(opts.mesh);
-    const Mesh& mesh = lm.mesh;
+    const Mesh& mesh = lm.user_mesh();  // inputs and outputs use the mesh's own numbering
     for (const auto& w : load_warnings(lm)) std::fprintf(stderr, "edgefem: warning: %s\n", w.c_str());
     const index_t nv = mesh.num_vertices();
 
@@ -38,20 +38,21 @@ void run_forces(const ForcesOptions& opts) {
     std::vector<double> dir;
     if (!opts.dir.empty()) dir = read_vectors(opts.dir, nv);
 
-    auto eval = make_evaluator(mesh, opts.model, opts.exec);
-    eval->set_displacement(u);
+    auto eval = make_evaluator(lm.mesh, opts.model, opts.exec);
+    eval->set_displacement(lm.to_internal(u));
     std::vector<double> f;
     const auto t0 = std::chrono::steady_clock::now();
     const double energy = eval->energy_forces(f);
     const auto t1 = std::chrono::steady_clock::now();
+    f = lm.to_user(f);
 
     write_scalar(opts.out + ".energy", energy);
     write_vectors(opts.out + ".force", f);
     if (!opts.deform.empty()) write_vectors(opts.out + ".pos", positions_from_displacement(mesh, u));
     if (!dir.empty()) {
         std::vector<double> Kd;
-        eval->stiffness_times(dir, Kd);
-        write_vectors(opts.out + ".Kdir", Kd);
+        eval->stiffness_times(lm.to_internal(dir), Kd);
+        write_vectors(opts.out + ".Kdir", lm.to_user(Kd));
     }
 
     double max_force = 0;  // largest nodal force magnitude

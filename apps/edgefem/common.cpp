@@ -12,6 +12,8 @@
 #include "edgefem/core/edge_kernels.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
+#include "edgefem/partition/ordering.hpp"
+#include "edgefem/partition/permute_mesh.hpp"
 #include "edgefem/core/tet_kernels.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/parallel/executors.hpp"
@@ -29,6 +31,9 @@ void add_mesh_options(CLI::App& cmd, MeshOptions& opts) {
     cmd.add_flag("--fix-orientation", opts.fix_orientation,
                  "Reorient negatively oriented tets instead of rejecting the mesh");
     cmd.add_flag("--compact", opts.compact, "Remove vertices that no tet uses");
+    cmd.add_option("--ordering", opts.ordering,
+                   "Renumber vertices for memory locality (input/output stay in the mesh's numbering)")
+        ->check(CLI::IsMember({"input", "random", "rcm", "morton", "nd", "metis"}));
 }
 
 LoadedMesh load_mesh(const MeshOptions& opts) {
@@ -41,7 +46,26 @@ LoadedMesh load_mesh(const MeshOptions& opts) {
     v.fix_orientation = opts.fix_orientation;
     v.compact_unreferenced = opts.compact;
     m.validation = validate_mesh(m.mesh, v);
+    if (const Ordering o = parse_ordering(opts.ordering); o != Ordering::Input) {
+        m.new_of_old = vertex_ordering(m.mesh, o);
+        m.user = std::move(m.mesh);
+        m.mesh = permute_mesh(m.user, m.new_of_old);
+    }
     return m;
+}
+
+std::vector<double> LoadedMesh::to_internal(const std::vector<double>& user_data) const {
+    if (new_of_old.empty()) return user_data;
+    std::vector<double> out(user_data.size());
+    edgefem::to_internal<double>(user_data, out, new_of_old);
+    return out;
+}
+
+std::vector<double> LoadedMesh::to_user(const std::vector<double>& internal_data) const {
+    if (new_of_old.empty()) return internal_data;
+    std::vector<double> out(internal_data.size());
+    edgefem::to_user<double>(internal_data, out, new_of_old);
+    return out;
 }
 
 std::vector<std::string> load_warnings(const LoadedMesh& m) {

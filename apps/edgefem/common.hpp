@@ -27,12 +27,22 @@ struct MeshOptions {
     std::string path;  // file, TetGen prefix or box:NXxNYxNZ
     bool fix_orientation = false;
     bool compact = false;
+    std::string ordering = "input";  // input | random | rcm | morton | nd | metis
 };
 
 struct LoadedMesh {
+    // `mesh` is what the kernels run on: renumbered by --ordering when one is
+    // given (new_of_old non-empty); `user` then keeps the mesh as read, and
+    // vertex data goes in and out in its numbering.
+    Mesh user;
+    std::vector<index_t> new_of_old;
     Mesh mesh;
     ReadReport read;              // empty for a generated box
     ValidationReport validation;
+
+    const Mesh& user_mesh() const { return new_of_old.empty() ? mesh : user; }
+    std::vector<double> to_internal(const std::vector<double>& user_data) const;
+    std::vector<double> to_user(const std::vector<double>& internal_data) const;
 };
 
 // Adds the MESH positional and --fix-orientation / --compact.

@@ -1,0 +1,499 @@
+// `edgefem accuracy`: run time against error on standard dynamic scenes.
+//
+// Scenes (no damping, so energy drift is purely numerical):
+//  cantilever  box 12x3x3 (0.12 m, 648 tets), Y = 2e5, nu = 0.35, clamped at
+//              x = min, released from rest under gravity -z;
+//  twist       box 10x2x2 (0.1 m, 240 tets), Y = 1e5, nu = 0.3, clamped at
+//              x = min, released from a 90-degree twist (linear in x) at rest;
+//  bunny       bunny-4k (a generated box of the same size without
+//              ../shared/meshes), Y = 5e4, nu = 0.4, the lowest 5% of its
+//              height fixed, released from rest under gravity -y.
+//
+// Each scene has a reference trajectory: backward Euler solved by Newton
+// (relative tolerance 1e-9) at a small dt_ref and at 2 dt_ref, double, edge
+// FE, combined by Richardson extrapolation (2 u(dt_ref) - u(2 dt_ref): backward
+// Euler is first order, so this cancels its leading error term), cached on
+// disk under --cache keyed by an FNV-1a hash of everything that defines it.
+// |u(dt_ref) - u(2 dt_ref)| (the plain dt_ref run's own error, estimated) is
+// printed as ref_floor: errors near it are not resolved. Each
+// configuration (integrator, dt, CG tolerance or fixed iterations, float or
+// double, FE or SN, definite K, edge or per-tet) is run over the same span
+// and compared at the sample times:
+//  error      max over sample times of |u - u_ref|_2 / max_t |u_ref(t)|_2
+//  drift      (E(T) - E(0)) / max_t (kinetic + elastic), E the total energy
+//             (kinetic + elastic + gravity potential)
+//  wall_per_s wall-clock seconds per simulated second (1 thread).
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/make_box.hpp"
+#include "edgefem/core/named_mesh.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/core/validate_mesh.hpp"
+#include "evidence_commands.hpp"
+
+namespace edgefem::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct AccScene {
+    std::string name, mesh_origin;
+    Scene scene;                 // integrator / dt / solver set per configuration
+    std::vector<double> u0;      // initial displacement (empty: rest)
+    double duration = 0;         // simulated seconds
+    int samples = 0;             // sample times duration * k / samples, k = 1..samples
+    double dt_ref = 0;
+};
+
+struct Config {
+    std::string label;
+    Integrator integrator = Integrator::SemiImplicit;
+    double dt = 1e-3;
+    double cg_tol = 1e-6;
+    int cg_fixed = 0;
+    bool single = false;
+    ModelKind model = ModelKind::FE;
+    bool definite = false;
+    Method method = Method::Edge;
+};
+
+struct Trajectory {
+    std::vector<std::vector<double>> u;  // at the sample times
+    std::vector<Energies> energy;        // at t = 0 and the sample times
+    double wall_s = 0;
+    double cg_mean = 0;
+    long steps = 0;
+    bool failed = false;
+    std::string message;
+};
+
+double coord(const Mesh& m, int axis, bool max) {
+    double v = max ? -1e300 : 1e300;
+    for (index_t i = 0; i < m.num_vertices(); ++i) v = max ? std::max(v, m.X[3 * i + axis]) : std::min(v, m.X[3 * i + axis]);
+    return v;
+}
+
+std::vector<index_t> below(const Mesh& m, int axis, double limit) {
+    std::vector<index_t> out;
+    for (index_t i = 0; i < m.num_vertices(); ++i)
+        if (m.X[3 * i + axis] <= limit) out.push_back(i);
+    return out;
+}
+
+std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, const std::string& only) {
+    std::vector<AccScene> out;
+    const double span = quick ? 0.5 : 1.0;
+    if (only.empty() || only == "cantilever") {
+        AccScene a;
+        a.name = "cantilever";
+        a.mesh_origin = "box 12x3x3";
+        a.scene.mesh = make_box(12, 3, 3, 0.01);
+        a.scene.materials = Material{2e5, 0.35, 1000};
+        a.scene.gravity = {0, 0, -9.81};
+        a.scene.fixed = below(a.scene.mesh, 0, coord(a.scene.mesh, 0, false) + 1e-9);
+        a.duration = 0.5 * span;
+        a.samples = 10;
+        a.dt_ref = 2e-5;
+        out.push_back(std::move(a));
+    }
+    if (only.empty() || only == "twist") {
+        AccScene b;
+        b.name = "twist";
+        b.mesh_origin = "box 10x2x2";
+        b.scene.mesh = make_box(10, 2, 2, 0.01);
+        b.scene.materials = Material{1e5, 0.3, 1000};
+        const Mesh& m = b.scene.mesh;
+        const double x0 = coord(m, 0, false), L = coord(m, 0, true) - x0;
+        b.scene.fixed = below(m, 0, x0 + 1e-9);
+        b.u0.assign(m.X.size(), 0.0);
+        for (index_t v = 0; v < m.num_vertices(); ++v) {
+            const double th = 0.5 * M_PI * (m.X[3 * v] - x0) / L, y = m.X[3 * v + 1], z = m.X[3 * v + 2];
+            b.u0[3 * v + 1] = std::cos(th) * y - std::sin(th) * z - y;
+            b.u0[3 * v + 2] = std::sin(th) * y + std::cos(th) * z - z;
+        }
+        b.duration = 0.5 * span;
+        b.samples = 10;
+        b.dt_ref = 2e-5;
+        out.push_back(std::move(b));
+    }
+    if (only.empty() || only == "bunny") {
+        AccScene c;
+        c.name = "bunny";
+        Mesh m = load_named_mesh(mesh_folder, "bunny-4k", &c.mesh_origin);
+        validate_mesh(m);
+        c.scene.mesh = std::move(m);
+        c.scene.materials = Material{5e4, 0.4, 1000};
+        c.scene.gravity = {0, -9.81, 0};
+        const double y0 = coord(c.scene.mesh, 1, false), y1 = coord(c.scene.mesh, 1, true);
+        c.scene.fixed = below(c.scene.mesh, 1, y0 + 0.05 * (y1 - y0));
+        c.duration = 0.3 * span;
+        c.samples = 6;
+        c.dt_ref = 5e-5;
+        out.push_back(std::move(c));
+    }
+    for (auto& s : out) {
+        s.scene.count_inverted_tets = false;
+        s.scene.rayleigh_alpha = 0;
+    }
+    return out;
+}
+
+std::vector<Config> make_configs(const AccScene& sc, bool quick) {
+    std::vector<Config> cs;
+    auto add = [&](Config c) { cs.push_back(c); };
+    const bool bunny = sc.name == "bunny";
+    // Explicit near and below its stability limit.
+    for (double dt : bunny ? std::vector<double>{2.5e-5, 5e-5} : std::vector<double>{5e-5, 1e-4, 2e-4}) {
+        if (quick && dt != (bunny ? 5e-5 : 1e-4)) continue;
+        Config c;
+        c.integrator = Integrator::Explicit;
+        c.dt = dt;
+        add(c);
+    }
+    for (double dt : quick ? std::vector<double>{1e-3, 4e-3} : std::vector<double>{5e-4, 1e-3, 2e-3, 4e-3, 1e-2}) {
+        Config c;
+        c.dt = dt;
+        add(c);
+    }
+    for (double dt : quick ? std::vector<double>{1e-3, 4e-3} : std::vector<double>{5e-4, 1e-3, 2e-3, 4e-3, 1e-2}) {
+        Config c;
+        c.integrator = Integrator::Implicit;
+        c.dt = dt;
+        add(c);
+    }
+    // One factor at a time around semi-implicit, dt = 2 ms, CG 1e-6, double, FE, edge.
+    Config base;
+    base.dt = 2e-3;
+    if (!quick) {
+        for (double tol : {1e-2, 1e-4, 1e-8}) {
+            Config c = base;
+            c.cg_tol = tol;
+            add(c);
+        }
+        for (int it : {5, 20}) {
+            Config c = base;
+            c.cg_fixed = it;
+            add(c);
+        }
+    } else {
+        Config c = base;
+        c.cg_fixed = 20;
+        add(c);
+    }
+    {
+        Config c = base;
+        c.single = true;
+        add(c);
+    }
+    {
+        Config c = base;
+        c.model = ModelKind::SN;
+        add(c);
+    }
+    {
+        Config c = base;
+        c.definite = true;
+        add(c);
+    }
+    {
+        Config c = base;
+        c.method = Method::Tet;
+        add(c);
+    }
+    if (!quick) {  // the same factors with the implicit integrator
+        Config c = base;
+        c.integrator = Integrator::Implicit;
+        c.single = true;
+        add(c);
+        c.single = false;
+        c.model = ModelKind::SN;
+        add(c);
+        c.model = ModelKind::FE;
+        c.method = Method::Tet;
+        add(c);
+    }
+    for (auto& c : cs) {
+        std::ostringstream os;
+        os << to_string(c.integrator) << " dt=" << c.dt;
+        if (c.integrator != Integrator::Explicit) {
+            if (c.cg_fixed)
+                os << " cg=" << c.cg_fixed << "it";
+            else if (c.cg_tol != 1e-6)
+                os << " cg=" << c.cg_tol;
+        }
+        if (c.single) os << " float";
+        if (c.model == ModelKind::SN) os << " SN";
+        if (c.definite) os << " definite";
+        if (c.method == Method::Tet) os << " per-tet";
+        c.label = os.str();
+    }
+    return cs;
+}
+
+Scene configured(const AccScene& sc, const Config& c) {
+    Scene s = sc.scene;
+    s.integrator = c.integrator;
+    s.dt = c.dt;
+    s.model = c.model;
+    s.method = c.method;
+    s.solver.cg_tolerance = c.cg_tol;
+    s.solver.cg_fixed_iterations = c.cg_fixed;
+    s.solver.definite_stiffness = c.definite;
+    s.solver.newton_tolerance = 1e-9;
+    s.solver.max_step_halvings = 3;
+    return s;
+}
+
+template <class S>
+Trajectory simulate(const AccScene& sc, const Config& c) {
+    Trajectory tr;
+    const auto t0 = Clock::now();
+    try {
+        Simulator<S> sim(configured(sc, c));
+        if (!sc.u0.empty()) std::copy(sc.u0.begin(), sc.u0.end(), sim.displacement().begin());
+        tr.energy.push_back(sim.energies());
+        const long total = std::lround(sc.duration / c.dt);
+        long cg = 0;
+        for (int k = 1; k <= sc.samples; ++k) {
+            const long until = std::lround(double(total) * k / sc.samples);
+            while (tr.steps < until) {
+                cg += sim.step().solver_iterations;
+                ++tr.steps;
+            }
+            const auto u = sim.displacement();
+            tr.u.emplace_back(u.begin(), u.end());
+            tr.energy.push_back(sim.energies());
+        }
+        tr.cg_mean = tr.steps ? double(cg) / double(tr.steps) : 0;
+    } catch (const SimulationError& e) {
+        tr.failed = true;
+        tr.message = e.what();
+    }
+    tr.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    return tr;
+}
+
+// ---- Reference cache --------------------------------------------------------
+
+std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+std::uint64_t scene_hash(const AccScene& sc, const Config& ref) {
+    const Scene s = configured(sc, ref);
+    std::uint64_t h = fnv1a(s.mesh.X.data(), s.mesh.X.size() * sizeof(double));
+    h = fnv1a(s.mesh.tets.data(), s.mesh.tets.size() * sizeof(index_t), h);
+    h = fnv1a(s.fixed.data(), s.fixed.size() * sizeof(index_t), h);
+    h = fnv1a(sc.u0.data(), sc.u0.size() * sizeof(double), h);
+    const Material& m = s.materials.fallback;
+    const double nums[] = {m.young, m.poisson, m.density, s.gravity[0], s.gravity[1], s.gravity[2], sc.duration,
+                           double(sc.samples), ref.dt, s.solver.newton_tolerance, s.solver.cg_tolerance, 3.0 /*format*/};
+    return fnv1a(nums, sizeof nums, h);
+}
+
+bool load_reference(const std::string& path, std::size_t n, int samples, Trajectory& tr) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return false;
+    tr.u.assign(samples, std::vector<double>(n));
+    tr.energy.assign(samples + 1, Energies{});
+    for (auto& u : tr.u) in.read(reinterpret_cast<char*>(u.data()), std::streamsize(n * sizeof(double)));
+    for (auto& e : tr.energy) {
+        double v[3];
+        in.read(reinterpret_cast<char*>(v), sizeof v);
+        e = {v[0], v[1], v[2]};
+    }
+    in.read(reinterpret_cast<char*>(&tr.wall_s), sizeof(double));
+    return bool(in);
+}
+
+void save_reference(const std::string& path, const Trajectory& tr) {
+    std::ofstream out(path + ".tmp", std::ios::binary);
+    for (const auto& u : tr.u) out.write(reinterpret_cast<const char*>(u.data()), std::streamsize(u.size() * sizeof(double)));
+    for (const auto& e : tr.energy) {
+        const double v[3] = {e.kinetic, e.elastic, e.gravity};
+        out.write(reinterpret_cast<const char*>(v), sizeof v);
+    }
+    out.write(reinterpret_cast<const char*>(&tr.wall_s), sizeof(double));
+    out.close();
+    if (!out) throw Error("cannot write the reference cache " + path);
+    std::filesystem::rename(path + ".tmp", path);
+}
+
+double norm(const std::vector<double>& a) {
+    double s = 0;
+    for (double x : a) s += x * x;
+    return std::sqrt(s);
+}
+
+double drift(const std::vector<Energies>& e) {
+    double scale = 0;
+    for (const auto& x : e) scale = std::max(scale, x.kinetic + x.elastic);
+    return scale > 0 ? (e.back().total() - e.front().total()) / scale : 0;
+}
+
+std::string jnum(double x) {
+    if (!std::isfinite(x)) return "null";
+    char b[40];
+    std::snprintf(b, sizeof b, "%.6g", x);
+    return b;
+}
+
+std::string jstr(const std::string& s) {
+    std::string o = "\"";
+    for (char ch : s) {
+        if (ch == '"' || ch == '\\') o += '\\';
+        o += (static_cast<unsigned char>(ch) < 0x20) ? ' ' : ch;
+    }
+    return o + "\"";
+}
+
+std::string default_cache_dir() {
+    std::error_code ec;
+    const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) return (exe.parent_path().parent_path() / "accuracy-cache").string();
+    return "accuracy-cache";
+}
+
+std::string default_mesh_dir() {
+    std::error_code ec;
+    const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) {
+        const auto d = exe.parent_path().parent_path().parent_path().parent_path() / "shared" / "meshes";
+        if (std::filesystem::exists(d)) return d.string();
+    }
+    return "../shared/meshes";
+}
+
+}  // namespace
+
+void add_accuracy_command(CLI::App& app) {
+    struct Options {
+        bool quick = false;
+        std::string cache, json, scene, mesh_dir;
+    };
+    auto opts = std::make_shared<Options>();
+    CLI::App* cmd = app.add_subcommand("accuracy", "Run time against error on standard scenes (reference: implicit Newton, small dt)");
+    cmd->add_flag("--quick", opts->quick, "Half the simulated span and fewer configurations");
+    cmd->add_option("--cache", opts->cache, "Folder for the cached reference trajectories (default: build/accuracy-cache)");
+    cmd->add_option("--json", opts->json, "Write the results as JSON to this file");
+    cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny"}));
+    cmd->add_option("--mesh-dir", opts->mesh_dir,
+                    "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)");
+    cmd->callback([opts] {
+        const std::string cache = opts->cache.empty() ? default_cache_dir() : opts->cache;
+        std::filesystem::create_directories(cache);
+        const std::string mesh_folder = opts->mesh_dir.empty() ? mesh_dir(default_mesh_dir()) : opts->mesh_dir;
+        std::ostringstream js;
+        js << "{\"quick\": " << (opts->quick ? "true" : "false") << ", \"scenes\": [";
+        bool first_scene = true;
+        for (const AccScene& sc : make_scenes(opts->quick, mesh_folder, opts->scene)) {
+            Config ref;
+            ref.integrator = Integrator::Implicit;
+            ref.dt = sc.dt_ref;
+            char hex[20];
+            std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(scene_hash(sc, ref)));
+            const std::string path = cache + "/" + sc.name + "-" + hex + ".ref";
+            Config ref2 = ref;
+            ref2.dt = 2 * sc.dt_ref;
+            const std::string path2 = cache + "/" + sc.name + "-" + hex + "-2dt.ref";
+            Trajectory rt, rt2;
+            const bool cached = load_reference(path, sc.scene.mesh.X.size(), sc.samples, rt) &&
+                                load_reference(path2, sc.scene.mesh.X.size(), sc.samples, rt2);
+            if (!cached) {
+                std::fprintf(stderr, "accuracy: %s: computing the reference (implicit, dt %g and %g, %g s)...\n",
+                             sc.name.c_str(), sc.dt_ref, 2 * sc.dt_ref, sc.duration);
+                rt = simulate<double>(sc, ref);
+                if (rt.failed) throw SimulationError("reference for " + sc.name + ": " + rt.message, 0);
+                rt2 = simulate<double>(sc, ref2);
+                if (rt2.failed) throw SimulationError("reference for " + sc.name + " (2 dt): " + rt2.message, 0);
+                save_reference(path, rt);
+                save_reference(path2, rt2);
+            }
+            const double ref_drift = drift(rt.energy), ref_wall = rt.wall_s + rt2.wall_s;
+            double uref_max = 0, floor = 0;
+            for (int k = 0; k < sc.samples; ++k) {
+                double d2 = 0;
+                for (std::size_t i = 0; i < rt.u[k].size(); ++i) {
+                    const double a = rt.u[k][i], b = rt2.u[k][i];
+                    d2 += (a - b) * (a - b);
+                    rt.u[k][i] = 2 * a - b;  // Richardson extrapolation
+                }
+                uref_max = std::max(uref_max, norm(rt.u[k]));
+                floor = std::max(floor, std::sqrt(d2));
+            }
+            floor /= uref_max;
+            std::printf("scene %s (%s, %d tets): %g s simulated, reference implicit dt %g & %g extrapolated (%s, %.1f s), "
+                        "ref_floor %.3g, reference drift %.3g\n",
+                        sc.name.c_str(), sc.mesh_origin.c_str(), sc.scene.mesh.num_tets(), sc.duration, sc.dt_ref,
+                        2 * sc.dt_ref, cached ? "cached" : "computed", ref_wall, floor, ref_drift);
+            std::printf("  %-44s %12s %10s %10s %8s\n", "configuration", "wall/sim_s", "error", "drift", "cg/step");
+            if (!first_scene) js << ",";
+            first_scene = false;
+            js << "\n {\"name\": " << jstr(sc.name) << ", \"mesh\": " << jstr(sc.mesh_origin)
+               << ", \"tets\": " << sc.scene.mesh.num_tets() << ", \"duration\": " << jnum(sc.duration)
+               << ", \"samples\": " << sc.samples << ", \"dt_ref\": " << jnum(sc.dt_ref)
+               << ", \"reference_wall_s\": " << jnum(ref_wall) << ", \"reference_drift\": " << jnum(ref_drift)
+               << ", \"reference_floor\": " << jnum(floor)
+               << ", \"reference_cache\": " << jstr(path) << ", \"configs\": [";
+            bool first = true;
+            for (const Config& c : make_configs(sc, opts->quick)) {
+                const Trajectory t = c.single ? simulate<float>(sc, c) : simulate<double>(sc, c);
+                double err = NAN, err_mean = NAN, dr = NAN;
+                if (!t.failed) {
+                    err = 0;
+                    err_mean = 0;
+                    for (int k = 0; k < sc.samples; ++k) {
+                        std::vector<double> d(t.u[k].size());
+                        for (std::size_t i = 0; i < d.size(); ++i) d[i] = t.u[k][i] - rt.u[k][i];
+                        const double e = norm(d) / uref_max;
+                        err = std::max(err, e);
+                        err_mean += e / sc.samples;
+                    }
+                    dr = drift(t.energy);
+                    std::printf("  %-44s %12.4g %10.3g %10.3g %8.1f\n", c.label.c_str(), t.wall_s / sc.duration, err, dr,
+                                t.cg_mean);
+                } else {
+                    std::printf("  %-44s %12.4g  failed cleanly with error: %s\n", c.label.c_str(), t.wall_s / sc.duration,
+                                t.message.c_str());
+                }
+                std::fflush(stdout);
+                if (!first) js << ",";
+                first = false;
+                js << "\n  {\"label\": " << jstr(c.label) << ", \"integrator\": " << jstr(to_string(c.integrator))
+                   << ", \"dt\": " << jnum(c.dt) << ", \"cg_tolerance\": " << jnum(c.cg_tol)
+                   << ", \"cg_fixed_iterations\": " << c.cg_fixed << ", \"precision\": " << jstr(c.single ? "float" : "double")
+                   << ", \"model\": " << jstr(c.model == ModelKind::SN ? "sn" : "fe")
+                   << ", \"definite\": " << (c.definite ? "true" : "false")
+                   << ", \"method\": " << jstr(c.method == Method::Tet ? "tet" : "edge")
+                   << ", \"wall_s\": " << jnum(t.wall_s) << ", \"wall_per_sim_s\": " << jnum(t.wall_s / sc.duration)
+                   << ", \"error_max\": " << jnum(err) << ", \"error_mean\": " << jnum(err_mean)
+                   << ", \"energy_drift\": " << jnum(dr) << ", \"cg_per_step\": " << jnum(t.cg_mean)
+                   << ", \"failed\": " << (t.failed ? "true" : "false") << ", \"message\": " << jstr(t.message) << "}";
+            }
+            js << "\n ]}";
+        }
+        js << "\n]}\n";
+        if (!opts->json.empty()) {
+            std::ofstream out(opts->json);
+            out << js.str();
+            if (!out) throw Error("cannot write " + opts->json);
+        }
+    });
+}
+
+}  // namespace edgefem::cli

@@ -1,0 +1,14 @@
+// The evidence subcommands (docs/benchmarks.md): `edgefem stress`, the
+// numerical stability stress suite, and `edgefem accuracy`, run time against
+// error on standard scenes. Wiring only: the stress suite lives in core
+// (edgefem/core/stress_suite.hpp).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace edgefem::cli {
+
+void add_stress_command(CLI::App& app);
+void add_accuracy_command(CLI::App& app);
+
+}  // namespace edgefem::cli
