@@ -125,10 +125,8 @@ public:
     virtual void consume() = 0;
 };
 
-// Builds the chosen model for `mesh` (opts must be validated).
-std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts);
-// The same on the chosen back-end (parallel_evaluator.cpp); the serial
-// default gives the evaluator above.
+// Builds the chosen model for `mesh` (opts must be validated) on the chosen
+// back-end (evaluator.cpp).
 std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec);
 
 // ---- Text I/O -------------------------------------------------------------

@@ -1,0 +1,91 @@
+// The one Evaluator of `forces` and `bench`: any elastic model through its
+// ElasticOperator, on core's serial kernels or a parallel back-end.
+#include <memory>
+
+#include "common.hpp"
+#include "edgefem/core/elastic_operator.hpp"
+#include "edgefem/parallel/executors.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
+
+namespace edgefem::cli {
+
+namespace {
+
+// Tells the compiler that the memory behind p is read, so the stores of a
+// timed call cannot be dropped.
+inline void escape(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
+
+// Any elastic model (edge FE/SN or per-tet; serial or parallel kernels)
+// through its ElasticOperator; doubles at the interface, the kernel's scalar
+// inside, converted once outside the timed calls.
+template <class S>
+class OperatorEvaluator final : public Evaluator {
+public:
+    explicit OperatorEvaluator(std::unique_ptr<ElasticOperator<S>> op)
+        : op_(std::move(op)), u_(3 * std::size_t(op_->num_vertices()), S(0)), f_(u_.size()), x_(u_.size()), y_(u_.size()) {}
+
+    void set_displacement(const std::vector<double>& u) override { u_.assign(u.begin(), u.end()); }
+    double energy_forces(std::vector<double>& f) override {
+        const double W = op_->forces(u_.data(), f_.data(), true);
+        f.assign(f_.begin(), f_.end());
+        return W;
+    }
+    void stiffness_times(const std::vector<double>& x, std::vector<double>& y) override {
+        prepare(Kernel::Kx, x);
+        run(Kernel::Kx);
+        y.assign(y_.begin(), y_.end());
+    }
+    // stiffness and kx start from the state of a force call; kx also from a
+    // precomputed K.
+    void prepare(Kernel kernel, const std::vector<double>& x) override {
+        x_.assign(x.begin(), x.end());
+        if (kernel == Kernel::Stiffness || kernel == Kernel::Kx) op_->forces(u_.data(), f_.data(), false);
+        if (kernel == Kernel::Kx) op_->build_stiffness(false);
+    }
+    void run(Kernel kernel) override {
+        switch (kernel) {
+            case Kernel::Force: op_->forces(u_.data(), f_.data(), false); break;
+            case Kernel::Stiffness: op_->build_stiffness(false); break;
+            case Kernel::ForceStiffness:
+                op_->forces(u_.data(), f_.data(), false);
+                op_->build_stiffness(false);
+                break;
+            case Kernel::Kx: op_->multiply(x_.data(), y_.data()); break;
+        }
+    }
+    void consume() override {
+        escape(f_.data());
+        escape(y_.data());
+    }
+
+private:
+    std::unique_ptr<ElasticOperator<S>> op_;
+    std::vector<S> u_, f_, x_, y_;
+};
+
+template <class S>
+std::unique_ptr<Evaluator> make_evaluator_as(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec) {
+    const edgefem::Method method = opts.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
+    OperatorFactory<S> factory = operator_factory<S>(exec, exec.executor());
+    auto op = factory ? factory(mesh, opts.material, opts.kind(), method)
+                      : make_elastic_operator<S>(mesh, opts.material, opts.kind(), method);
+    return std::make_unique<OperatorEvaluator<S>>(std::move(op));
+}
+
+}  // namespace
+
+std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec) {
+    if (opts.precision_kind() == Precision::Float) return make_evaluator_as<float>(mesh, opts, exec);
+    return make_evaluator_as<double>(mesh, opts, exec);
+}
+
+template <class S>
+OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor) {
+    if (!exec.parallel_kernels()) return {};
+    return parallel_operator_factory<S>(executor, parse_variant(exec.variant));
+}
+
+template OperatorFactory<double> operator_factory<double>(const ExecOptions&, const std::shared_ptr<const Executor>&);
+template OperatorFactory<float> operator_factory<float>(const ExecOptions&, const std::shared_ptr<const Executor>&);
+
+}  // namespace edgefem::cli
