@@ -17,6 +17,7 @@ packages=(
   pybind11-dev        # Python bindings (build/python/edgefem*.so)
   python3-dev         # Python headers for the bindings
   python3-numpy       # Python bindings: arrays (system python3)
+  python3-matplotlib  # bench/report: the plots of docs/benchmarks.md (system python3)
   python3-pytest      # tests: the Python suite
   doxygen             # API reference (ctest api_reference_doxygen)
 )

@@ -1,0 +1,213 @@
+// The paper's comparison (Kikuuwe et al. 2009, Table 1) reproduced: time of
+// F, K, F+K and a whole semi-implicit step, edge-based FE and SN against the
+// per-tet method, 1 thread and all threads, double and float, on the paper's
+// mesh sizes (box-1200, spot-2k for the dinosaur, bunny-4k, armadillo-7k;
+// generated boxes of the same size where ../shared/meshes is absent), plus
+// the force kernel on bunny-1m (1 thread, double: the large-mesh
+// target).
+//
+// Names: paper/<kernel>/<method>/<precision>/<threads>t/<mesh>, kernel in
+// force | stiffness | force+stiffness | step; method edge-fe | edge-sn | tet.
+// 1 thread runs core's serial loops (make_elastic_operator, the serial
+// Simulator); more threads run parallel/'s operators (OpenMP executor, the
+// gather variant: deterministic, and the fastest at 2 threads in
+// bench_parallel; the per-tet operator runs coloured) and the Simulator on
+// the same executor.
+//
+// Kernels run on the twist configuration (edgefem/core/deformations.hpp),
+// Y = 1e5 Pa, nu = 0.3. The step: h = 1 ms, gravity -z, the lowest 1% of
+// the mesh height fixed, 20 warm-started CG iterations (as bench_step).
+//
+// Counters: per_tet (s per tet, shown in ns), flops_per_tet (hand-derived
+// formulas of bench/flop_counts.hpp, checked exactly against a counting
+// scalar by tests/test_flop_counts.cpp and again at start-up here; the
+// per-tet counts leave out the energy arithmetic the compiler drops),
+// gflops (flops_per_tet / per_tet), tets, edges, tseps.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "bench_meshes.hpp"
+#include "counting_scalar.hpp"
+#include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/deformations.hpp"
+#include "edgefem/core/elastic_operator.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/executors.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
+#include "flop_counts.hpp"
+
+using namespace edgefem;
+
+namespace {
+
+enum class Kernel { Force, Stiffness, ForceStiffness, Step };
+enum class Which { EdgeFE, EdgeSN, Tet };
+
+const char* name_of(Kernel k) {
+    switch (k) {
+        case Kernel::Force: return "force";
+        case Kernel::Stiffness: return "stiffness";
+        case Kernel::ForceStiffness: return "force+stiffness";
+        default: return "step";
+    }
+}
+const char* name_of(Which m) { return m == Which::EdgeFE ? "edge-fe" : m == Which::EdgeSN ? "edge-sn" : "tet"; }
+ModelKind model_of(Which m) { return m == Which::EdgeSN ? ModelKind::SN : ModelKind::FE; }
+Method method_of(Which m) { return m == Which::Tet ? Method::Tet : Method::Edge; }
+
+const Materials& materials() {
+    static const Materials mat(Material{1e5, 0.3, 1000});
+    return mat;
+}
+
+// Item counts of a mesh (from its edge model) and the instrumented check.
+const flops::Items& items(const std::string& mesh_name) {
+    static std::map<std::string, flops::Items> cache;
+    auto it = cache.find(mesh_name);
+    if (it != cache.end()) return it->second;
+    const Mesh& mesh = bench::bench_mesh(mesh_name);
+    const Topology topo = build_topology(mesh);
+    const EdgeModel<double> em = make_edge_model<double>(topo, compute_coefficients(mesh, topo, materials()));
+    const flops::Items n = flops::items_of(em);
+    if (mesh.num_tets() <= 20000) {  // instrumented run: formulas must match exactly
+        const TetModel<double> tm = make_tet_model<double>(mesh, materials());
+        const auto got = flops::count_kernels(em, tm, deformation_displacement(mesh, Deformation::Twist));
+        const bool ok = double(got.edge_force_fe) == flops::edge_force(n, ModelKind::FE).counted &&
+                        double(got.edge_stiffness_fe) == flops::edge_stiffness(n, ModelKind::FE).counted &&
+                        double(got.edge_force_sn) == flops::edge_force(n, ModelKind::SN).counted &&
+                        double(got.tet_force) == flops::tet_force(n, true).counted &&
+                        double(got.tet_stiffness) == flops::tet_stiffness(n, true).counted;
+        std::fprintf(stderr, "%s: E=%.0f P=%.0f T=%.0f; FLOP formulas vs counting scalar: %s\n", mesh_name.c_str(), n.E,
+                     n.P, n.T, ok ? "exact match" : "MISMATCH");
+    }
+    return cache.emplace(mesh_name, n).first->second;
+}
+
+double flops_of(const flops::Items& n, Kernel k, Which m) {
+    const ModelKind kind = model_of(m);
+    if (m == Which::Tet) {
+        switch (k) {
+            case Kernel::Force: return flops::tet_force(n, false).total;
+            case Kernel::Stiffness: return flops::tet_stiffness(n, false).total;
+            case Kernel::ForceStiffness: return (flops::tet_force(n, false) + flops::tet_stiffness(n, false)).total;
+            default: return 0;
+        }
+    }
+    switch (k) {
+        case Kernel::Force: return flops::edge_force(n, kind).total;
+        case Kernel::Stiffness: return flops::edge_stiffness(n, kind).total;
+        case Kernel::ForceStiffness: return (flops::edge_force(n, kind) + flops::edge_stiffness(n, kind)).total;
+        default: return 0;
+    }
+}
+
+std::shared_ptr<const Executor> executor_for(int threads) {
+    static std::map<int, std::shared_ptr<const Executor>> cache;
+    auto& e = cache[threads];
+    if (!e) e = make_executor(Backend::OpenMP, threads, Schedule::Dynamic);
+    return e;
+}
+
+template <class S>
+std::unique_ptr<ElasticOperator<S>> make_op(const Mesh& mesh, Which m, int threads) {
+    if (threads == 1) return make_elastic_operator<S>(mesh, materials(), model_of(m), method_of(m));
+    return make_parallel_operator<S>(mesh, materials(), model_of(m), method_of(m), executor_for(threads),
+                                     Variant::Gather);
+}
+
+Scene step_scene(const Mesh& mesh, Which m) {
+    Scene s;
+    s.mesh = mesh;
+    s.materials = materials();
+    s.model = model_of(m);
+    s.method = method_of(m);
+    s.gravity = {0, 0, -9.81};
+    s.dt = 1e-3;
+    double lo = 1e300, hi = -1e300;
+    for (index_t v = 0; v < mesh.num_vertices(); ++v) {
+        lo = std::min(lo, mesh.X[3 * v + 2]);
+        hi = std::max(hi, mesh.X[3 * v + 2]);
+    }
+    for (index_t v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.X[3 * v + 2] <= lo + 0.01 * (hi - lo)) s.fixed.push_back(v);
+    s.solver.cg_fixed_iterations = 20;
+    s.count_inverted_tets = false;
+    return s;
+}
+
+template <class S>
+void BM_Paper(benchmark::State& state, std::string mesh_name, Kernel k, Which m, int threads) {
+    const Mesh& mesh = bench::bench_mesh(mesh_name);
+    const flops::Items& n = items(mesh_name);
+    if (k == Kernel::Step) {
+        Scene s = step_scene(mesh, m);
+        std::unique_ptr<Simulator<S>> sim;
+        if (threads == 1) {
+            sim = std::make_unique<Simulator<S>>(std::move(s));
+        } else {
+            auto ex = executor_for(threads);
+            sim = std::make_unique<Simulator<S>>(std::move(s), ex, parallel_operator_factory<S>(ex, Variant::Gather));
+        }
+        for (int i = 0; i < 3; ++i) sim->step();  // warm: K, buffers, a moving state
+        for (auto _ : state) sim->step();
+        state.counters["cg_iterations"] = sim->last_stats().solver_iterations;
+    } else {
+        auto op = make_op<S>(mesh, m, threads);
+        const auto ud = deformation_displacement(mesh, Deformation::Twist);
+        std::vector<S> u(ud.begin(), ud.end()), f(u.size());
+        op->forces(u.data(), f.data(), false);
+        op->build_stiffness(false);
+        for (auto _ : state) {
+            switch (k) {
+                case Kernel::Force: op->forces(u.data(), f.data(), false); break;
+                case Kernel::Stiffness: op->build_stiffness(false); break;
+                default:
+                    op->forces(u.data(), f.data(), false);
+                    op->build_stiffness(false);
+                    break;
+            }
+            benchmark::DoNotOptimize(f.data());
+            benchmark::ClobberMemory();
+        }
+        const double fl = flops_of(n, k, m) / n.T;
+        state.counters["flops_per_tet"] = fl;
+        state.counters["gflops"] = benchmark::Counter(fl * n.T * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+    }
+    state.counters["per_tet"] =
+        benchmark::Counter(n.T, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["tets"] = n.T;
+    state.counters["edges"] = n.E;
+    state.counters["tseps"] = n.P;
+    state.counters["threads"] = threads;
+}
+
+void add(const std::string& mesh, Kernel k, Which m, bool single, int threads) {
+    const std::string name = std::string("paper/") + name_of(k) + "/" + name_of(m) + "/" + (single ? "float" : "double") +
+                             "/" + std::to_string(threads) + "t/" + mesh;
+    auto* b = single ? benchmark::RegisterBenchmark(name.c_str(), BM_Paper<float>, mesh, k, m, threads)
+                     : benchmark::RegisterBenchmark(name.c_str(), BM_Paper<double>, mesh, k, m, threads);
+    b->Unit(benchmark::kMicrosecond)->UseRealTime();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    benchmark::Initialize(&argc, argv);
+    const int all = std::max(1, hardware_threads());
+    std::vector<int> thread_counts = {1};
+    if (all > 1) thread_counts.push_back(all);
+    for (const char* mesh : {"box-1200", "spot-2k", "bunny-4k", "armadillo-7k"})
+        for (Kernel k : {Kernel::Force, Kernel::Stiffness, Kernel::ForceStiffness, Kernel::Step})
+            for (Which m : {Which::EdgeFE, Which::EdgeSN, Which::Tet})
+                for (bool single : {false, true})
+                    for (int t : thread_counts) add(mesh, k, m, single, t);
+    // The large-mesh force target (about 0.5 GB of models): 1 thread, double.
+    for (Which m : {Which::EdgeFE, Which::Tet}) add("bunny-1m", Kernel::Force, m, false, 1);
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+}
