@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
 #include "edgefem/core/cg.hpp"
 #include "edgefem/core/coefficients.hpp"
@@ -17,6 +19,13 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// %.3e, for residuals in messages (std::to_string prints 0.000000).
+std::string sci(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3e", v);
+    return buf;
 }
 
 // A failed step, caught to retry with a halved step.
@@ -339,6 +348,9 @@ struct Simulator<S>::Impl {
             scale = std::sqrt(fn) + std::sqrt(hn) + std::sqrt(in);
         };
 
+        // The residual cannot fall below the round-off of S: a float model
+        // is converged at ~1e-5 whatever the scene asks.
+        const double tolerance = std::max(sv.newton_tolerance, 100 * double(std::numeric_limits<S>::epsilon()));
         double phi = 0, scale = 0;
         evaluate(phi, scale);
         for (int it = 0;; ++it) {
@@ -348,11 +360,11 @@ struct Simulator<S>::Impl {
             stats.residual = scale > 0 ? rn / scale : rn;
             if (!std::isfinite(rn))
                 throw StepFailure{"step " + std::to_string(step + 1) + ": non-finite residual in Newton", -1};
-            if (rn <= sv.newton_tolerance * scale) return;
+            if (rn <= tolerance * scale) return;
             if (it == sv.newton_max_iterations)
                 throw StepFailure{"step " + std::to_string(step + 1) + ": Newton did not converge in " +
                                       std::to_string(sv.newton_max_iterations) + " iterations (relative residual " +
-                                      std::to_string(stats.residual) + ")",
+                                      sci(stats.residual) + ")",
                                   -1};
             ++stats.newton_iterations;
             // Solve (c_m M + K + c_b K0) du = -R, du = 0 on constrained dofs.
