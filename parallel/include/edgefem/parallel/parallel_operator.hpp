@@ -1,7 +1,7 @@
 // Elastic operators whose kernels run on an Executor, for the Simulator:
 //
 //   auto ex = make_executor(Backend::TBB, 2);
-//   Simulator<double> sim(scene, ex, parallel_operator_factory<double>(ex, Variant::Colour));
+//   Simulator<double> sim(scene, ex, parallel_operator_factory<double>(ex));  // gather variant
 //
 // The executor runs the CG vector operations, the factory's operators run
 // forces, stiffness, K x, diagonal blocks and the inverted-tet count on the
@@ -20,14 +20,14 @@
 namespace edgefem {
 
 template <class S>
-OperatorFactory<S> parallel_operator_factory(std::shared_ptr<const Executor> executor, Variant variant = Variant::Colour,
+OperatorFactory<S> parallel_operator_factory(std::shared_ptr<const Executor> executor, Variant variant = Variant::Gather,
                                              PlanOptions opts = {});
 
 // Direct construction (what the factory calls).
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_parallel_operator(const Mesh& mesh, const Materials& materials, ModelKind model,
                                                            Method method, std::shared_ptr<const Executor> executor,
-                                                           Variant variant = Variant::Colour,
+                                                           Variant variant = Variant::Gather,
                                                            const PlanOptions& opts = {});
 
 // Tets with non-positive deformed volume, counted on the executor (blocked,
