@@ -32,6 +32,7 @@
 #include <string>
 
 #include "bench_meshes.hpp"
+#include "edgefem/core/benchmark_scene.hpp"
 #include "counting_scalar.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
@@ -121,22 +122,9 @@ std::unique_ptr<ElasticOperator<S>> make_op(const Mesh& mesh, Which m, int threa
 }
 
 Scene step_scene(const Mesh& mesh, Which m) {
-    Scene s;
-    s.mesh = mesh;
-    s.materials = materials();
+    Scene s = step_benchmark_scene(mesh, materials());
     s.model = model_of(m);
     s.method = method_of(m);
-    s.gravity = {0, 0, -9.81};
-    s.dt = 1e-3;
-    double lo = 1e300, hi = -1e300;
-    for (index_t v = 0; v < mesh.num_vertices(); ++v) {
-        lo = std::min(lo, mesh.X[3 * v + 2]);
-        hi = std::max(hi, mesh.X[3 * v + 2]);
-    }
-    for (index_t v = 0; v < mesh.num_vertices(); ++v)
-        if (mesh.X[3 * v + 2] <= lo + 0.01 * (hi - lo)) s.fixed.push_back(v);
-    s.solver.cg_fixed_iterations = 20;
-    s.count_inverted_tets = false;
     return s;
 }
 

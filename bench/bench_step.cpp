@@ -12,6 +12,7 @@
 #include <functional>
 
 #include "bench_meshes.hpp"
+#include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/edge_kernels.hpp"
@@ -21,23 +22,7 @@ using namespace edgefem;
 
 namespace {
 
-Scene step_scene(const Mesh& mesh) {
-    Scene s;
-    s.mesh = mesh;
-    s.materials = Material{1e5, 0.3, 1000};
-    s.gravity = {0, 0, -9.81};
-    s.dt = 1e-3;
-    double lo = 1e300, hi = -1e300;
-    for (index_t v = 0; v < mesh.num_vertices(); ++v) {
-        lo = std::min(lo, mesh.X[3 * v + 2]);
-        hi = std::max(hi, mesh.X[3 * v + 2]);
-    }
-    for (index_t v = 0; v < mesh.num_vertices(); ++v)
-        if (mesh.X[3 * v + 2] <= lo + 0.01 * (hi - lo)) s.fixed.push_back(v);
-    s.solver.cg_fixed_iterations = 20;
-    s.count_inverted_tets = false;
-    return s;
-}
+Scene step_scene(const Mesh& mesh) { return step_benchmark_scene(mesh, Material{1e5, 0.3, 1000}); }
 
 void BM_Step(benchmark::State& state, std::string mesh_name, std::function<void(Scene&)> tweak, bool energy) {
     Scene s = step_scene(bench::bench_mesh(mesh_name));

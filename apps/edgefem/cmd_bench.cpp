@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
@@ -74,21 +75,9 @@ void print_header(const BenchOptions& opts, const Mesh& mesh) {
 // along z under gravity -z; the state moves on from call to call.
 template <class S>
 void bench_step(const BenchOptions& opts, Mesh mesh) {
-    Scene scene;
-    double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
-    for (index_t v = 0; v < mesh.num_vertices(); ++v) {
-        zmin = std::min(zmin, mesh.X[3 * std::size_t(v) + 2]);
-        zmax = std::max(zmax, mesh.X[3 * std::size_t(v) + 2]);
-    }
-    for (index_t v = 0; v < mesh.num_vertices(); ++v)
-        if (mesh.X[3 * std::size_t(v) + 2] <= zmin + 0.01 * (zmax - zmin)) scene.fixed.push_back(v);
-    scene.mesh = std::move(mesh);
-    scene.materials = opts.model.material;
+    Scene scene = step_benchmark_scene(std::move(mesh), opts.model.material);
     scene.model = opts.model.kind();
     scene.method = opts.model.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
-    scene.gravity = {0, 0, -9.81};
-    scene.integrator = Integrator::SemiImplicit;
-    scene.dt = 1e-3;
     scene.solver.cg_tolerance = 1e-6;
     scene.solver.cg_fixed_iterations = opts.cg_iters;
     const auto ex = opts.exec.executor();
