@@ -71,6 +71,7 @@ TEST(SceneJson, Defaults) {
     EXPECT_EQ(s.solver.newton_max_iterations, d.solver.newton_max_iterations);
     EXPECT_EQ(s.solver.load_steps, d.solver.load_steps);
     EXPECT_EQ(s.solver.max_step_halvings, d.solver.max_step_halvings);
+    EXPECT_EQ(s.solver.stiffness_interval, 1);
     EXPECT_EQ(sf.output.dir, "edgefem-out");
     EXPECT_EQ(sf.output.every, 10);
     EXPECT_TRUE(sf.output.vtu);
@@ -99,7 +100,7 @@ TEST(SceneJson, EveryKey) {
         "steps": 1e3,
         "solver": {"linear": "direct", "cg_tolerance": 1e-8, "cg_max_iterations": 77, "cg_fixed_iterations": 5,
                    "definite_stiffness": true, "newton_tolerance": 1e-9, "newton_max_iterations": 12,
-                   "load_steps": 3, "max_step_halvings": 2},
+                   "load_steps": 3, "max_step_halvings": 2, "stiffness_interval": 4},
         "output": {"dir": "out/here", "every": 4, "vtu": false}
     })",
                                dir.path());
@@ -136,6 +137,7 @@ TEST(SceneJson, EveryKey) {
     EXPECT_EQ(s.solver.newton_max_iterations, 12);
     EXPECT_EQ(s.solver.load_steps, 3);
     EXPECT_EQ(s.solver.max_step_halvings, 2);
+    EXPECT_EQ(s.solver.stiffness_interval, 4);
     EXPECT_EQ(sf.output.dir, "out/here");
     EXPECT_EQ(sf.output.every, 4);
     EXPECT_FALSE(sf.output.vtu);

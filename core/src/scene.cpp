@@ -53,6 +53,7 @@ void Scene::validate() const {
     if (solver.newton_max_iterations < 1) bad("solver.newton_max_iterations", "must be >= 1");
     if (solver.load_steps < 1) bad("solver.load_steps", "must be >= 1");
     if (solver.max_step_halvings < 0) bad("solver.max_step_halvings", "must be >= 0");
+    if (solver.stiffness_interval < 1) bad("solver.stiffness_interval", "must be >= 1");
     std::vector<char> seen(nv, 0);
     for (std::size_t i = 0; i < fixed.size(); ++i) {
         if (fixed[i] < 0 || fixed[i] >= nv)

@@ -49,6 +49,8 @@ struct Simulator<S>::Impl {
     std::vector<index_t> con_vertex;              // fixed and prescribed vertices
     std::vector<std::array<double, 3>> con_disp;  // their final displacement
     StepStats stats;
+    int stiffness_age = 0;     // semi-implicit steps since K was built (0: none yet)
+    double stiffness_dt = 0;   // the step size K's system matrix was built for
     long step = 0;
     double time = 0;
 
@@ -179,8 +181,10 @@ struct Simulator<S>::Impl {
     // Solves A x = b on the free dofs; x holds the constrained values and a
     // warm start. Builds K (definite if asked) first; on negative curvature
     // with the plain K it retries once with the definite K.
-    CgResult solve(double c_m, double c_k, double c_b, double tolerance, bool definite) {
-        CgResult res = solve_once(c_m, c_k, c_b, tolerance, definite);
+    // `reuse_stiffness`: keep the K and preconditioner of an earlier solve
+    // (matrix-free CG only; see SolverSettings::stiffness_interval).
+    CgResult solve(double c_m, double c_k, double c_b, double tolerance, bool definite, bool reuse_stiffness = false) {
+        CgResult res = solve_once(c_m, c_k, c_b, tolerance, definite, reuse_stiffness);
         if (res.negative_curvature && !definite && scene.method == Method::Edge) {
             stats.negative_curvature = true;
             const int its = res.iterations;
@@ -190,9 +194,11 @@ struct Simulator<S>::Impl {
         return res;
     }
 
-    CgResult solve_once(double c_m, double c_k, double c_b, double tolerance, bool definite) {
+    CgResult solve_once(double c_m, double c_k, double c_b, double tolerance, bool definite,
+                        bool reuse_stiffness = false) {
         auto t0 = Clock::now();
-        op->build_stiffness(definite);
+        reuse_stiffness = reuse_stiffness && scene.solver.linear_solver == LinearSolver::CG;
+        if (!reuse_stiffness) op->build_stiffness(definite);
         CgResult res;
         if (scene.solver.linear_solver == LinearSolver::Direct) {
             const index_t nf = number_free_dofs(free_dof, dof_index);
@@ -226,7 +232,7 @@ struct Simulator<S>::Impl {
             stats.solve_ms += ms_since(t0);
             return res;
         }
-        build_preconditioner(c_m, c_k, c_b);
+        if (!reuse_stiffness) build_preconditioner(c_m, c_k, c_b);
         stats.stiffness_ms += ms_since(t0);
         t0 = Clock::now();
         res = conjugate_gradient(
@@ -303,7 +309,12 @@ struct Simulator<S>::Impl {
             x[i] = double(v[i]);  // warm start
         });
         constrained_velocities(T, time + T, x.data());
-        const CgResult res = solve(c_m, c_k, 0.0, scene.solver.cg_tolerance, scene.solver.definite_stiffness);
+        // Reuse K while the interval allows and the step size is the one it
+        // was built for (a halved step changes the system matrix).
+        const bool reuse = stiffness_age > 0 && stiffness_age < scene.solver.stiffness_interval && T == stiffness_dt;
+        const CgResult res = solve(c_m, c_k, 0.0, scene.solver.cg_tolerance, scene.solver.definite_stiffness, reuse);
+        stiffness_age = reuse ? stiffness_age + 1 : 1;
+        stiffness_dt = T;
         stats.residual = res.residual;
         if (!std::isfinite(res.residual))
             throw StepFailure{"step " + std::to_string(step + 1) + ": linear solve failed (non-finite residual)", -1};

@@ -9,7 +9,7 @@
 // (they are counted as dropped) instead of running a backlog.
 //
 //   edgefem_haptic_loop [--mesh PATH|box:NXxNYxNZ] [--seconds S] [--rate HZ]
-//       [--cg-iters N] [--precision double|float] [--model fe|sn]
+//       [--cg-iters N] [--stiffness-interval N] [--precision double|float] [--model fe|sn]
 //       [--backend serial|omp|tbb] [--threads N] [--force NEWTONS]
 #include <algorithm>
 #include <chrono>
@@ -48,6 +48,7 @@ struct Options {
     int cg_iters = 3;
     std::string precision = "double";
     std::string model = "fe";
+    int stiffness_interval = 1;  // build K every N steps (a lagged tangent)
     std::string backend = "serial";
     int threads = 0;
     double force = 0.2;  // N, spread over the probed vertices
@@ -62,7 +63,7 @@ struct Options {
 [[noreturn]] void usage(const char* msg) {
     std::fprintf(stderr,
                  "edgefem_haptic_loop: %s\nusage: edgefem_haptic_loop [--mesh PATH|box:NXxNYxNZ] [--seconds S] "
-                 "[--rate HZ] [--cg-iters N] [--precision double|float] [--model fe|sn] "
+                 "[--rate HZ] [--cg-iters N] [--stiffness-interval N] [--precision double|float] [--model fe|sn] "
                  "[--backend serial|omp|tbb] [--threads N] [--force N] [--young PA] [--alpha 1/S] [--indefinite] [--free-run] [--gravity G]\n",
                  msg);
     std::exit(2);
@@ -82,6 +83,7 @@ Options parse(int argc, char** argv) {
         else if (a == "--cg-iters") o.cg_iters = std::atoi(next().c_str());
         else if (a == "--precision") o.precision = next();
         else if (a == "--model") o.model = next();
+        else if (a == "--stiffness-interval") o.stiffness_interval = std::atoi(next().c_str());
         else if (a == "--backend") o.backend = next();
         else if (a == "--threads") o.threads = std::atoi(next().c_str());
         else if (a == "--force") o.force = std::atof(next().c_str());
@@ -193,6 +195,7 @@ int run(const Options& o) {
     scene.rayleigh_alpha = o.alpha;  // light damping so the poked body settles
     scene.solver.definite_stiffness = o.definite;
     scene.solver.cg_fixed_iterations = o.cg_iters;
+    scene.solver.stiffness_interval = o.stiffness_interval;
     scene.count_inverted_tets = false;  // a statistic the loop does not need
 
     std::shared_ptr<const Executor> executor;
@@ -218,6 +221,7 @@ int run(const Options& o) {
                 o.precision.c_str(), backend.c_str(), threads);
     std::printf("young_pa: %g\nrayleigh_alpha: %g\ndefinite_stiffness: %s\n", o.young, o.alpha,
                 o.definite ? "true" : "false");
+    std::printf("stiffness_interval: %d\n", o.stiffness_interval);
     std::printf("cg_fixed_iterations: %d\nrate_hz: %g\nbudget_ms: %g\nprobe_force_n: %g\n", o.cg_iters, o.rate,
                 1e3 / o.rate, o.force);
 

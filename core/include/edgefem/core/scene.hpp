@@ -36,6 +36,10 @@ struct SolverSettings {
     int newton_max_iterations = 50;
     int load_steps = 1;               // static: initial number of load steps (halved on failure)
     int max_step_halvings = 0;        // dynamics: retry a failed step with dt/2 up to this often
+    // Semi-implicit with CG: build K (and its preconditioner) every this many
+    // steps and reuse it in between: a lagged tangent, as haptic loops do to
+    // fit their budget. 1 (default) builds K every step.
+    int stiffness_interval = 1;
 };
 
 // A vertex driven to a target position.
