@@ -52,20 +52,7 @@ EDGEFEM_COUNTED_MIXED(/)
 
 // The double models converted to the counting scalar (same indices and
 // coefficients).
-inline EdgeModel<Counted> counted_model(const EdgeModel<double>& m) {
-    EdgeModel<Counted> c;
-    c.num_vertices = m.num_vertices;
-    c.num_tets = m.num_tets;
-    c.edge = m.edge;
-    c.edge_first = m.edge_first;
-    c.rest.assign(m.rest.begin(), m.rest.end());
-    c.LE.assign(m.LE.begin(), m.LE.end());
-    c.tsep_first = m.tsep_first;
-    c.tsep_other = m.tsep_other;
-    c.LP.assign(m.LP.begin(), m.LP.end());
-    c.target = m.target;
-    return c;
-}
+inline EdgeModel<Counted> counted_model(const EdgeModel<double>& m) { return convert_scalar<Counted>(m); }
 
 inline TetModel<Counted> counted_model(const TetModel<double>& m) {
     TetModel<Counted> c;

@@ -16,13 +16,6 @@ namespace edgefem {
 
 namespace {
 
-std::string lower(std::string_view s) {
-    std::string out(s);
-    for (char& c : out)
-        if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    return out;
-}
-
 // Keyword stream: tokens across lines, as MEDIT allows "Dimension\n3".
 class Words {
 public:
@@ -83,7 +76,7 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
     for (;;) {
         const std::string_view word = words.next();
         if (word.empty()) break;  // End is optional
-        const std::string kw = lower(word);
+        const std::string kw = detail::ascii_lower(word);
         if (kw == "end") break;
         if (kw == "dimension") {
             const std::int64_t dim = words.next_int("the dimension");

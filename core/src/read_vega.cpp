@@ -12,13 +12,6 @@ namespace edgefem {
 
 namespace {
 
-std::string upper(std::string_view s) {
-    std::string out(s);
-    for (char& c : out)
-        if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
-    return out;
-}
-
 // Reads "<count> <per-item> ..." and checks the per-item value.
 index_t read_block_header(detail::TextReader& r, const char* kind, std::int64_t per_item,
                           const char* per_item_name, int min_tokens) {
@@ -62,7 +55,7 @@ Mesh read_vega(const std::string& path, ReadReport* /*report*/) {
         if (r.line().front() != '*')
             r.fail("expected a *KEYWORD line such as *VERTICES, got '" + detail::quote(r.line()) + "'");
         auto kt = r.tokens();
-        const std::string kw = upper(kt.next().substr(1));
+        const std::string kw = detail::ascii_upper(kt.next().substr(1));
         if (kw == "VERTICES") {
             if (have_vertices) r.fail("a second *VERTICES section");
             have_vertices = true;
@@ -88,7 +81,7 @@ Mesh read_vega(const std::string& path, ReadReport* /*report*/) {
             if (have_tets) r.fail("a second *ELEMENTS section");
             have_tets = true;
             r.require_line("the element type (TET)");
-            const std::string type = upper(r.line());
+            const std::string type = detail::ascii_upper(r.line());
             if (type != "TET" && type != "TETS")
                 r.fail("Vega element type '" + detail::quote(r.line()) +
                        "' is not supported (only TET)");

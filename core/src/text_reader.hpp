@@ -83,6 +83,10 @@ private:
 
 // A token made safe to quote in a message: at most 40 characters,
 // non-printable bytes shown as '?'.
+// ASCII-only case conversion for keywords (locale-independent).
+std::string ascii_lower(std::string_view s);
+std::string ascii_upper(std::string_view s);
+
 std::string quote(std::string_view token);
 
 // Case-insensitive ASCII comparison.

@@ -49,6 +49,24 @@ struct EdgeModel {
 template <class S>
 EdgeModel<S> make_edge_model(const Topology& topo, const Coefficients& coef);
 
+// The same model in another scalar type: indices copied, coefficients
+// converted (e.g. to an instrumented scalar that counts operations).
+template <class To, class From>
+EdgeModel<To> convert_scalar(const EdgeModel<From>& m) {
+    EdgeModel<To> c;
+    c.num_vertices = m.num_vertices;
+    c.num_tets = m.num_tets;
+    c.edge = m.edge;
+    c.edge_first = m.edge_first;
+    c.rest.assign(m.rest.begin(), m.rest.end());
+    c.LE.assign(m.LE.begin(), m.LE.end());
+    c.tsep_first = m.tsep_first;
+    c.tsep_other = m.tsep_other;
+    c.LP.assign(m.LP.begin(), m.LP.end());
+    c.target = m.target;
+    return c;
+}
+
 extern template struct EdgeModel<double>;
 extern template struct EdgeModel<float>;
 extern template EdgeModel<double> make_edge_model<double>(const Topology&, const Coefficients&);
