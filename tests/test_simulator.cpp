@@ -292,3 +292,25 @@ TEST(Simulator, StiffnessIntervalReusesKAndStaysClose) {
     lagged.solver.stiffness_interval = 0;
     EXPECT_THROW(Simulator<double>{lagged}, InvalidArgument);
 }
+
+// A CG solve cut off by its iteration cap is never silent: counted in the
+// step's statistics, and an error (naming the step) when the scene asks.
+TEST(Simulator, UnconvergedSolvesAreCountedOrFatal) {
+    Scene s = cantilever(Integrator::SemiImplicit, 1e-2);
+    s.materials = Material{1e8, 0.3, 1000};  // stiff: many iterations needed
+    s.solver.cg_tolerance = 1e-10;
+    s.solver.cg_max_iterations = 3;
+    Simulator<double> counted(s);
+    EXPECT_GT(counted.step().unconverged_solves, 0);
+    s.solver.fail_on_unconverged = true;
+    Simulator<double> strict(s);
+    try {
+        strict.step();
+        FAIL() << "no error";
+    } catch (const SimulationError& e) {
+        EXPECT_NE(std::string(e.what()).find("step 1: CG stopped at 3 iterations"), std::string::npos) << e.what();
+    }
+    s.solver.cg_max_iterations = 5000;  // enough: no count, no error
+    Simulator<double> enough(s);
+    EXPECT_EQ(enough.step().unconverged_solves, 0);
+}

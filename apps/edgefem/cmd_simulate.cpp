@@ -114,6 +114,7 @@ void run_simulate(const SimulateOptions& opts) {
     long cg_total = 0;
     int cg_max = 0;
     index_t inverted_max = 0;
+    long unconverged_steps = 0;  // CG stopped above its tolerance
     Progress progress(steps);
     write_frame();
     try {
@@ -127,6 +128,7 @@ void run_simulate(const SimulateOptions& opts) {
             cg_total += st.solver_iterations;
             cg_max = std::max(cg_max, st.solver_iterations);
             inverted_max = std::max(inverted_max, st.inverted_tets);
+            unconverged_steps += st.unconverged_solves > 0;
             if (s % out.every == 0 || s == steps) {
                 write_frame();
                 sample_energy();
@@ -150,6 +152,7 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("solve_ms", fmt(median(solve_ms), 6));
     print_kv("cg_iterations_mean", fmt(steps > 0 ? double(cg_total) / double(steps) : 0.0, 6));
     print_kv("cg_iterations_max", cg_max);
+    print_kv("unconverged_steps", unconverged_steps);
     print_kv("energy_drift", fmt(e_drift, 6));
     print_kv("inverted_tets", inverted_max);
     if (out.vtu) print_kv("output", (std::filesystem::path(out.dir) / (name + ".pvd")).string());

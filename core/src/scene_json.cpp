@@ -325,13 +325,14 @@ void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     check_keys(cx, v, p,
                {"linear", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "definite_stiffness",
                 "newton_tolerance", "newton_max_iterations", "load_steps", "max_step_halvings",
-                "stiffness_interval"});
+                "stiffness_interval", "fail_on_unconverged"});
     if (const json* x = find(v, "linear"))
         s.linear_solver = get_enum<LinearSolver>(cx, *x, join(p, "linear"), {{"cg", LinearSolver::CG}, {"direct", LinearSolver::Direct}});
     if (const json* x = find(v, "cg_tolerance")) s.cg_tolerance = get_number(cx, *x, join(p, "cg_tolerance"), Range::Positive);
     if (const json* x = find(v, "cg_max_iterations")) s.cg_max_iterations = get_int(cx, *x, join(p, "cg_max_iterations"), 1);
     if (const json* x = find(v, "cg_fixed_iterations")) s.cg_fixed_iterations = get_int(cx, *x, join(p, "cg_fixed_iterations"), 0);
     if (const json* x = find(v, "definite_stiffness")) s.definite_stiffness = get_bool(cx, *x, join(p, "definite_stiffness"));
+    if (const json* x = find(v, "fail_on_unconverged")) s.fail_on_unconverged = get_bool(cx, *x, join(p, "fail_on_unconverged"));
     if (const json* x = find(v, "newton_tolerance")) s.newton_tolerance = get_number(cx, *x, join(p, "newton_tolerance"), Range::Positive);
     if (const json* x = find(v, "newton_max_iterations")) s.newton_max_iterations = get_int(cx, *x, join(p, "newton_max_iterations"), 1);
     if (const json* x = find(v, "load_steps")) s.load_steps = get_int(cx, *x, join(p, "load_steps"), 1);

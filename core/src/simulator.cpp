@@ -318,6 +318,14 @@ struct Simulator<S>::Impl {
         stats.residual = res.residual;
         if (!std::isfinite(res.residual))
             throw StepFailure{"step " + std::to_string(step + 1) + ": linear solve failed (non-finite residual)", -1};
+        if (!res.converged && scene.solver.cg_fixed_iterations == 0 && scene.solver.linear_solver == LinearSolver::CG) {
+            ++stats.unconverged_solves;
+            if (scene.solver.fail_on_unconverged)
+                throw StepFailure{"step " + std::to_string(step + 1) + ": CG stopped at " +
+                                      std::to_string(res.iterations) + " iterations with relative residual " +
+                                      sci(res.residual) + " above the tolerance " + sci(scene.solver.cg_tolerance),
+                                  -1};
+        }
         each([&](std::size_t i) {
             v[i] = S(x[i]);
             u[i] += S(T * x[i]);

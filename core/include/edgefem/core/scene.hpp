@@ -40,6 +40,11 @@ struct SolverSettings {
     // steps and reuse it in between: a lagged tangent, as haptic loops do to
     // fit their budget. 1 (default) builds K every step.
     int stiffness_interval = 1;
+    // Semi-implicit with a CG tolerance: a solve that stops at
+    // cg_max_iterations above the tolerance is counted in
+    // StepStats::unconverged_solves; with this set it fails the step
+    // (SimulationError, or a retry with max_step_halvings) instead.
+    bool fail_on_unconverged = false;
 };
 
 // A vertex driven to a target position.

@@ -38,6 +38,7 @@ struct StepStats {
     int newton_iterations = 0;  // Implicit / static
     double residual = 0;        // final relative residual of the last solve
     bool negative_curvature = false;  // CG met p^T A p <= 0 (K indefinite)
+    int unconverged_solves = 0;  // semi-implicit CG solves that stopped above their tolerance
     index_t inverted_tets = 0;  // at the end of the step
     int halvings = 0;           // step halvings used
 };
