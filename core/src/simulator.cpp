@@ -56,7 +56,8 @@ struct Simulator<S>::Impl {
 
     // Scratch.
     std::vector<double> h, x, b, Ax, Dinv;
-    std::vector<S> xs, ys;
+    std::vector<S> xs, ys, D, D0;   // D, D0: diagonal blocks of K and K0 (9 #V)
+    std::vector<double> newton_d;   // u - u0 in Newton's residual
     CgWork cg;
     std::vector<index_t> dof_index;
 
@@ -152,7 +153,7 @@ struct Simulator<S>::Impl {
     // block that is not positive definite falls back to its mass part so
     // the preconditioner stays SPD.
     void build_preconditioner(double c_m, double c_k, double c_b) {
-        std::vector<S> D(9 * mass.size()), D0;
+        D.resize(9 * mass.size());
         op->diagonal_blocks(D.data());
         if (c_b != 0) {
             D0.resize(D.size());
@@ -346,7 +347,8 @@ struct Simulator<S>::Impl {
             const double W = forces(true);
             phi = W;
             double fn = 0, hn = 0, in = 0;
-            std::vector<double> d(n());
+            std::vector<double>& d = newton_d;
+            d.resize(n());
             for (std::size_t i = 0; i < n(); ++i) d[i] = double(u[i]) - (dynamic ? u0[i] : 0.0);
             if (c_b != 0) multiply(*op_damp, d.data(), K0d.data());
             for (std::size_t i = 0; i < n(); ++i) {
