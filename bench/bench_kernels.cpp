@@ -11,6 +11,7 @@
 #include "bench_meshes.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/core/tet_kernels.hpp"
 
 using namespace edgefem;
@@ -18,7 +19,7 @@ using namespace edgefem;
 namespace {
 
 enum class Kernel { Force, Stiffness, ForceStiffness, Kx };
-enum class Method { EdgeFE, EdgeSN, Tet };
+enum class Method { EdgeFE, EdgeFETetForm, EdgeSN, Tet };
 
 const char* name_of(Kernel k) {
     switch (k) {
@@ -28,11 +29,19 @@ const char* name_of(Kernel k) {
         default: return "kx";
     }
 }
-const char* name_of(Method m) { return m == Method::EdgeFE ? "edge-fe" : m == Method::EdgeSN ? "edge-sn" : "tet"; }
+const char* name_of(Method m) {
+    switch (m) {
+        case Method::EdgeFE: return "edge-fe";
+        case Method::EdgeFETetForm: return "edge-fe-tetform";
+        case Method::EdgeSN: return "edge-sn";
+        default: return "tet";
+    }
+}
 
 template <class S>
 struct Prepared {
     EdgeModel<S> edge;
+    TetEdgeForm<S> form;
     TetModel<S> tet;
     std::vector<S> u, x;
 };
@@ -47,6 +56,7 @@ const Prepared<S>& prepared(const std::string& name) {
         const Topology topo = build_topology(mesh);
         p = std::make_unique<Prepared<S>>();
         p->edge = make_edge_model<S>(topo, compute_coefficients(mesh, topo, mat));
+        p->form = make_tet_edge_form<S>(mesh, topo, mat);
         p->tet = make_tet_model<S>(mesh, mat);
         const auto u = deformation_displacement(mesh, Deformation::Twist);
         p->u.assign(u.begin(), u.end());
@@ -79,6 +89,30 @@ void run_edge(benchmark::State& state, const Prepared<S>& p, Kernel k) {
     }
 }
 
+// The edge-based FE model with the tet-local form instead of the TSEP list.
+template <class S>
+void run_tet_form(benchmark::State& state, const Prepared<S>& p, Kernel k) {
+    std::vector<S> f(p.u.size()), y(p.u.size());
+    EdgeState<S> st;
+    EdgeStiffness<S> K;
+    tet_form_forces<ModelKind::FE, false>(p.edge, p.form, p.u.data(), f.data(), st);
+    tet_form_stiffness_all<ModelKind::FE>(p.edge, p.form, st, K);
+    for (auto _ : state) {
+        switch (k) {
+            case Kernel::Force: tet_form_forces<ModelKind::FE, false>(p.edge, p.form, p.u.data(), f.data(), st); break;
+            case Kernel::Stiffness: tet_form_stiffness_all<ModelKind::FE>(p.edge, p.form, st, K); break;
+            case Kernel::ForceStiffness:
+                tet_form_forces<ModelKind::FE, false>(p.edge, p.form, p.u.data(), f.data(), st);
+                tet_form_stiffness_all<ModelKind::FE>(p.edge, p.form, st, K);
+                break;
+            case Kernel::Kx: edge_multiply(p.edge, K, p.x.data(), y.data()); break;
+        }
+        benchmark::DoNotOptimize(f.data());
+        benchmark::DoNotOptimize(y.data());
+        benchmark::ClobberMemory();
+    }
+}
+
 template <class S>
 void run_tet(benchmark::State& state, const Prepared<S>& p, Kernel k) {
     std::vector<S> f(p.u.size()), y(p.u.size());
@@ -102,6 +136,8 @@ void BM_Kernel(benchmark::State& state, std::string mesh, Method m, Kernel k) {
     const Prepared<S>& p = prepared<S>(mesh);
     if (m == Method::EdgeFE)
         run_edge<ModelKind::FE>(state, p, k);
+    else if (m == Method::EdgeFETetForm)
+        run_tet_form(state, p, k);
     else if (m == Method::EdgeSN)
         run_edge<ModelKind::SN>(state, p, k);
     else
@@ -116,7 +152,7 @@ int main(int argc, char** argv) {
     benchmark::Initialize(&argc, argv);
     for (const char* mesh : bench::kBenchMeshes)
         for (Kernel k : {Kernel::Force, Kernel::Stiffness, Kernel::ForceStiffness, Kernel::Kx})
-            for (Method m : {Method::EdgeFE, Method::EdgeSN, Method::Tet})
+            for (Method m : {Method::EdgeFE, Method::EdgeFETetForm, Method::EdgeSN, Method::Tet})
                 for (int precision = 0; precision < 2; ++precision) {
                     const std::string name = std::string(name_of(k)) + "/" + name_of(m) + "/" +
                                              (precision ? "float" : "double") + "/" + mesh;

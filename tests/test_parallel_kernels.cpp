@@ -2,8 +2,8 @@
 // diagonal blocks) under OpenMP and TBB at 1, 2, 3, 4 and 8 threads.
 // Colour and gather: bitwise equal across thread counts and to the
 // SerialExecutor run of the same variant. Atomic and private: within 1e-12
-// of it. Every variant: within 1e-12 of core's serial kernels. Colourings:
-// conflict-free.
+// of it. Every variant: within 1e-12 of core's serial kernels. The same
+// with the FE stiffness from the tet-local form. Colourings: conflict-free.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -67,8 +67,9 @@ struct Outputs {
 
 template <ModelKind Kind, class S>
 Outputs<S> run_parallel(const EdgeModel<S>& model, std::shared_ptr<const Executor> ex, Variant v,
-                        const std::vector<S>& u, const std::vector<S>& x, const PlanOptions& opts = {}) {
-    ParallelEdgeKernels<S> k(model, std::move(ex), v, opts);
+                        const std::vector<S>& u, const std::vector<S>& x, const PlanOptions& opts = {},
+                        const TetEdgeForm<S>& form = {}) {
+    ParallelEdgeKernels<S> k(model, std::move(ex), v, opts, form);
     Outputs<S> o;
     o.f.assign(u.size(), S(7));  // garbage: the kernels overwrite
     o.y.assign(u.size(), S(7));
@@ -146,17 +147,23 @@ void check_edge_kernels(double core_tol) {
         const auto xd = deformation_displacement(nm.mesh, Deformation::Random);
         const std::vector<S> u(ud.begin(), ud.end()), x(xd.begin(), xd.end());
         const Outputs<S> core = run_core<Kind>(models.edge, u, x);
-        for (Variant v : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private}) {
-            const std::string tag = nm.name + "/" + to_string(v);
-            const Outputs<S> serial = run_parallel<Kind>(models.edge, std::make_shared<SerialExecutor>(), v, u, x);
-            expect_close(serial, core, core_tol, tag + "/serial vs core");
-            for (const auto& ne : executors()) {
-                if (nm.mesh.num_tets() > kOversubscribeMaxTets && ne.ex->threads() > 2) continue;
-                const Outputs<S> par = run_parallel<Kind>(models.edge, ne.ex, v, u, x);
-                if (is_deterministic(v))
-                    expect_bitwise(par, serial, tag + "/" + ne.name);
-                else
-                    expect_close(par, serial, (std::is_same_v<S, double> ? 1e-12 : core_tol), tag + "/" + ne.name);
+        TetEdgeForm<S> form;
+        if (Kind == ModelKind::FE) form = make_tet_edge_form<S>(nm.mesh, models.topo, Materials(Material{1e5, 0.3, 1000}));
+        for (bool tet_local : {false, true}) {
+            if (tet_local && Kind != ModelKind::FE) continue;
+            for (Variant v : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private}) {
+                const std::string tag = nm.name + "/" + to_string(v) + (tet_local ? "/tet-local" : "");
+                const TetEdgeForm<S>& fm = tet_local ? form : TetEdgeForm<S>{};
+                const Outputs<S> serial = run_parallel<Kind>(models.edge, std::make_shared<SerialExecutor>(), v, u, x, {}, fm);
+                expect_close(serial, core, core_tol, tag + "/serial vs core");
+                for (const auto& ne : executors()) {
+                    if (nm.mesh.num_tets() > kOversubscribeMaxTets && ne.ex->threads() > 2) continue;
+                    const Outputs<S> par = run_parallel<Kind>(models.edge, ne.ex, v, u, x, {}, fm);
+                    if (is_deterministic(v))
+                        expect_bitwise(par, serial, tag + "/" + ne.name);
+                    else
+                        expect_close(par, serial, (std::is_same_v<S, double> ? 1e-12 : core_tol), tag + "/" + ne.name);
+                }
             }
         }
     }
@@ -225,6 +232,15 @@ TEST(Colourings, ConflictFree) {
                 }
             }
         }
+        // The tet-local stiffness's batch colouring: a batch writes the edges
+        // of its tets, taken from the topology through the form's slot -> tet map.
+        const auto form = make_tet_edge_form<double>(nm.mesh, topo, Materials(Material{}));
+        const ResourceFn batch_w = [&](index_t b, std::vector<index_t>& out) {
+            for (index_t s = b * kTetLanes; s < std::min<index_t>(topo.num_tets, (b + 1) * kTetLanes); ++s)
+                for (index_t e : topo.tet_edges[form.slot_tet[s]]) out.push_back(e);
+        };
+        const ParallelEdgeKernels<double> pk(m, std::make_shared<SerialExecutor>(), Variant::Colour, {}, form);
+        EXPECT_EQ(colouring_conflicts(pk.form_colouring(), m.num_edges(), batch_w), 0) << nm.name;
         // The checker does catch a conflict.
         Colouring bad = colour_edges(m);
         if (m.num_edges() > 1) {

@@ -68,6 +68,7 @@ void print_header(const BenchOptions& opts, const Mesh& mesh) {
     print_kv("method", opts.model.method);
     print_kv("model", opts.model.model);
     print_kv("precision", opts.model.precision);
+    print_kv("layout", opts.model.layout);
     print_kv("backend", opts.exec.describe());
 }
 
@@ -81,7 +82,7 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     scene.solver.cg_tolerance = 1e-6;
     scene.solver.cg_fixed_iterations = opts.cg_iters;
     const auto ex = opts.exec.executor();
-    Simulator<S> sim(std::move(scene), ex, operator_factory<S>(opts.exec, ex));
+    Simulator<S> sim(std::move(scene), ex, operator_factory<S>(opts.exec, ex, opts.model.layout_kind()));
 
     std::vector<int> iterations;  // of every call, warm-up included
     const std::vector<double> ns = time_calls(opts.seconds, [&] { iterations.push_back(sim.step().solver_iterations); });

@@ -92,6 +92,11 @@ void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required
     cmd.add_option("--precision", opts.precision, "Scalar type of the kernels")
         ->check(CLI::IsMember({"double", "float"}))
         ->capture_default_str();
+    cmd.add_option("--layout", opts.layout,
+                   "Where the edge FE stiffness takes its pair terms from: tet-local (per-tet 6x6 form) or "
+                   "tsep-list (the mesh-wide TSEP list); results agree to round-off")
+        ->check(CLI::IsMember({"tet-local", "tsep-list"}))
+        ->capture_default_str();
     auto* young = cmd.add_option("--young", opts.material.young, "Young's modulus (Pa)");
     auto* poisson = cmd.add_option("--poisson", opts.material.poisson, "Poisson ratio, in (-1, 0.5)");
     if (material_required) {

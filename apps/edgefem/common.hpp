@@ -63,16 +63,18 @@ struct ModelOptions {
     std::string model = "fe";         // fe | sn
     std::string method = "edge";      // edge | tet
     std::string precision = "double"; // double | float
+    std::string layout = "tet-local"; // tet-local | tsep-list (edge FE stiffness)
     Material material;
 
     ModelKind kind() const { return model == "sn" ? ModelKind::SN : ModelKind::FE; }
     Method method_kind() const { return method == "tet" ? Method::Tet : Method::Edge; }
     Precision precision_kind() const { return precision == "float" ? Precision::Float : Precision::Double; }
+    StiffnessLayout layout_kind() const { return parse_stiffness_layout(layout); }
     // Throws InvalidArgument for an invalid material or --method tet --model sn.
     void validate() const;
 };
 
-// Adds --model, --method, --precision, --young, --poisson, --density.
+// Adds --model, --method, --precision, --layout, --young, --poisson, --density.
 // `material_required`: --young/--poisson must be given (forces) or default
 // to the Material defaults (bench).
 void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required);
@@ -97,9 +99,10 @@ struct ExecOptions {
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant = true);
 
 // The elastic-model factory a simulator should use under `exec` (empty for
-// core's serial kernels), running on `executor`.
+// core's serial kernels with the default layout), running on `executor`.
 template <class S>
-OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor);
+OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor,
+                                    StiffnessLayout layout = StiffnessLayout::TetLocal);
 
 // The kernels `bench` times (see its --help).
 enum class Kernel { Force, Stiffness, ForceStiffness, Kx };

@@ -66,9 +66,9 @@ private:
 template <class S>
 std::unique_ptr<Evaluator> make_evaluator_as(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec) {
     const edgefem::Method method = opts.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
-    OperatorFactory<S> factory = operator_factory<S>(exec, exec.executor());
+    OperatorFactory<S> factory = operator_factory<S>(exec, exec.executor(), opts.layout_kind());
     auto op = factory ? factory(mesh, opts.material, opts.kind(), method)
-                      : make_elastic_operator<S>(mesh, opts.material, opts.kind(), method);
+                      : make_elastic_operator<S>(mesh, opts.material, opts.kind(), method, opts.layout_kind());
     return std::make_unique<OperatorEvaluator<S>>(std::move(op));
 }
 
@@ -80,12 +80,22 @@ std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& 
 }
 
 template <class S>
-OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor) {
-    if (!exec.parallel_kernels()) return {};
-    return parallel_operator_factory<S>(executor, parse_variant(exec.variant));
+OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor,
+                                    StiffnessLayout layout) {
+    if (!exec.parallel_kernels()) {
+        if (layout == StiffnessLayout::TetLocal) return {};
+        return [layout](const Mesh& mesh, const Materials& materials, ModelKind model, edgefem::Method method) {
+            return make_elastic_operator<S>(mesh, materials, model, method, layout);
+        };
+    }
+    PlanOptions plan;
+    plan.stiffness_layout = layout;
+    return parallel_operator_factory<S>(executor, parse_variant(exec.variant), plan);
 }
 
-template OperatorFactory<double> operator_factory<double>(const ExecOptions&, const std::shared_ptr<const Executor>&);
-template OperatorFactory<float> operator_factory<float>(const ExecOptions&, const std::shared_ptr<const Executor>&);
+template OperatorFactory<double> operator_factory<double>(const ExecOptions&, const std::shared_ptr<const Executor>&,
+                                                          StiffnessLayout);
+template OperatorFactory<float> operator_factory<float>(const ExecOptions&, const std::shared_ptr<const Executor>&,
+                                                        StiffnessLayout);
 
 }  // namespace edgefem::cli

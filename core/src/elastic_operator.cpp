@@ -4,6 +4,7 @@
 #include "edgefem/core/edge_kernels.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/inverted_tets.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/core/tet_kernels.hpp"
 
 namespace edgefem {
@@ -13,9 +14,13 @@ namespace {
 template <class S, ModelKind Kind>
 class EdgeOperator final : public ElasticOperator<S> {
 public:
-    EdgeOperator(const Mesh& mesh, const Materials& materials) : mesh_(mesh) {
+    EdgeOperator(const Mesh& mesh, const Materials& materials, StiffnessLayout layout) : mesh_(mesh) {
         const Topology topo = build_topology(mesh);
         model_ = make_edge_model<S>(topo, compute_coefficients(mesh, topo, materials));
+        if (Kind == ModelKind::FE && layout == StiffnessLayout::TetLocal) {
+            form_ = make_tet_edge_form<S>(mesh, topo, materials);
+            model_.target = {};  // the TSEP targets serve only the TSEP-list stiffness
+        }
         state_.resize(model_.num_edges());
         K_.resize(model_.num_edges());
         scratch_.resize(3 * std::size_t(model_.num_vertices));
@@ -26,10 +31,16 @@ public:
     }
     double energy(const S* u) override { return edge_forces<Kind, true>(model_, u, scratch_.data(), state_); }
     void build_stiffness(bool definite) override {
-        if (definite)
+        if (form_.num_tets > 0) {
+            if (definite)
+                tet_form_stiffness_all<Kind, true>(model_, form_, state_, K_);
+            else
+                tet_form_stiffness_all<Kind, false>(model_, form_, state_, K_);
+        } else if (definite) {
             edge_stiffness_all<Kind, true>(model_, state_, K_);
-        else
+        } else {
             edge_stiffness_all<Kind, false>(model_, state_, K_);
+        }
     }
     void multiply(const S* x, S* y) const override { edge_multiply(model_, K_, x, y); }
     void diagonal_blocks(S* D) const override { edge_diagonal_blocks(model_, K_, D); }
@@ -51,6 +62,7 @@ public:
 private:
     const Mesh& mesh_;
     EdgeModel<S> model_;
+    TetEdgeForm<S> form_;  // empty unless FE with the tet-local layout
     EdgeState<S> state_;
     EdgeStiffness<S> K_;
     std::vector<S> scratch_;
@@ -106,21 +118,29 @@ private:
 
 }  // namespace
 
+StiffnessLayout parse_stiffness_layout(const std::string& name) {
+    if (name == "tet-local") return StiffnessLayout::TetLocal;
+    if (name == "tsep-list") return StiffnessLayout::TsepList;
+    throw InvalidArgument("unknown stiffness layout '" + name + "' (expected tet-local or tsep-list)");
+}
+
+const char* to_string(StiffnessLayout layout) { return layout == StiffnessLayout::TetLocal ? "tet-local" : "tsep-list"; }
+
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_elastic_operator(const Mesh& mesh, const Materials& materials,
-                                                          ModelKind model, Method method) {
+                                                          ModelKind model, Method method, StiffnessLayout layout) {
     if (method == Method::Tet) {
         if (model == ModelKind::SN)
             throw InvalidArgument("the spring-network model exists only for the edge method");
         return std::make_unique<TetOperator<S>>(mesh, materials);
     }
-    if (model == ModelKind::SN) return std::make_unique<EdgeOperator<S, ModelKind::SN>>(mesh, materials);
-    return std::make_unique<EdgeOperator<S, ModelKind::FE>>(mesh, materials);
+    if (model == ModelKind::SN) return std::make_unique<EdgeOperator<S, ModelKind::SN>>(mesh, materials, layout);
+    return std::make_unique<EdgeOperator<S, ModelKind::FE>>(mesh, materials, layout);
 }
 
 template std::unique_ptr<ElasticOperator<double>> make_elastic_operator<double>(const Mesh&, const Materials&, ModelKind,
-                                                                               Method);
+                                                                               Method, StiffnessLayout);
 template std::unique_ptr<ElasticOperator<float>> make_elastic_operator<float>(const Mesh&, const Materials&, ModelKind,
-                                                                             Method);
+                                                                             Method, StiffnessLayout);
 
 }  // namespace edgefem

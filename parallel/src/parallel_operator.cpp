@@ -45,7 +45,7 @@ class ParallelEdgeOperator final : public ElasticOperator<S> {
 public:
     ParallelEdgeOperator(const Mesh& mesh, const Materials& materials, std::shared_ptr<const Executor> ex,
                          Variant variant, const PlanOptions& opts)
-        : mesh_(mesh), k_(build_model(mesh, materials), std::move(ex), variant, opts) {
+        : mesh_(mesh), k_(build_kernels(mesh, materials, std::move(ex), variant, opts)) {
         state_.resize(k_.model().num_edges());
         k_.resize(K_);
         scratch_.resize(3 * std::size_t(k_.model().num_vertices));
@@ -82,9 +82,15 @@ public:
     }
 
 private:
-    static EdgeModel<S> build_model(const Mesh& mesh, const Materials& materials) {
+    static ParallelEdgeKernels<S> build_kernels(const Mesh& mesh, const Materials& materials,
+                                                std::shared_ptr<const Executor> ex, Variant variant,
+                                                const PlanOptions& opts) {
         const Topology topo = build_topology(mesh);
-        return make_edge_model<S>(topo, compute_coefficients(mesh, topo, materials));
+        TetEdgeForm<S> form;
+        if (Kind == ModelKind::FE && opts.stiffness && opts.stiffness_layout == StiffnessLayout::TetLocal)
+            form = make_tet_edge_form<S>(mesh, topo, materials);
+        return ParallelEdgeKernels<S>(make_edge_model<S>(topo, compute_coefficients(mesh, topo, materials)),
+                                      std::move(ex), variant, opts, std::move(form));
     }
     const Mesh& mesh_;
     ParallelEdgeKernels<S> k_;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "edgefem/core/edge_model.hpp"
@@ -14,6 +15,15 @@
 namespace edgefem {
 
 enum class Method { Edge, Tet };
+
+// Where the edge method's FE stiffness takes its pair terms from: the
+// per-tet 6x6 form (tet_edge_form.hpp; 2-3x faster, measured in
+// docs/layouts.md) or the mesh-wide TSEP list with its 4 targets per pair.
+// Forces always run the TSEP list. SN and the per-tet method ignore it.
+enum class StiffnessLayout { TetLocal, TsepList };
+// "tet-local" | "tsep-list"; throws InvalidArgument otherwise.
+StiffnessLayout parse_stiffness_layout(const std::string& name);
+const char* to_string(StiffnessLayout layout);
 
 template <class S>
 class ElasticOperator {
@@ -43,6 +53,7 @@ public:
 // Throws InvalidArgument for SN with the per-tet method.
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_elastic_operator(const Mesh& mesh, const Materials& materials,
-                                                          ModelKind model, Method method);
+                                                          ModelKind model, Method method,
+                                                          StiffnessLayout layout = StiffnessLayout::TetLocal);
 
 }  // namespace edgefem

@@ -6,6 +6,11 @@
 // core/edge_kernel_variants.hpp. This class only decides which items run
 // where, and owns the per-mesh plan (colourings, gather lists, private
 // buffers). One object must not run two kernels at the same time.
+//
+// Given a tet-local form (tet_edge_form.hpp), the FE stiffness adds its pair
+// terms from it instead of the TSEP list, whatever the variant: as a
+// coloured scatter over batches of tets (no two batches of a colour write
+// the same K(E)), so the result is independent of the thread count.
 #pragma once
 
 #include <atomic>
@@ -14,7 +19,9 @@
 
 #include "edgefem/core/edge_kernel_variants.hpp"
 #include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/error.hpp"
 #include "edgefem/core/executor.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/parallel/colouring.hpp"
 #include "edgefem/parallel/loops.hpp"
 #include "edgefem/parallel/variant.hpp"
@@ -25,7 +32,7 @@ template <class S>
 class ParallelEdgeKernels {
 public:
     ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<const Executor> executor, Variant variant,
-                        const PlanOptions& opts = {});
+                        const PlanOptions& opts = {}, TetEdgeForm<S> form = {});
 
     const EdgeModel<S>& model() const { return m_; }
     const Executor& executor() const { return *ex_; }
@@ -50,6 +57,9 @@ public:
     const Colouring& edge_colouring() const { return edge_col_; }
     const Colouring& tsep_colouring() const { return tsep_col_; }
     const Colouring& stiffness_colouring() const { return stiff_col_; }
+    // Tet-local stiffness only: the colouring of the form's batches.
+    const Colouring& form_colouring() const { return form_col_; }
+    bool tet_local_stiffness() const { return form_.num_tets > 0; }
     // Bytes of the plan (colour lists, gather lists; private buffers once allocated).
     std::size_t plan_bytes() const;
 
@@ -82,6 +92,8 @@ private:
     int parts_ = 1;          // private accumulators
     index_t num_sinks_ = 1;  // sink blocks after the #E edge blocks
     Colouring edge_col_, tsep_col_, stiff_col_;
+    TetEdgeForm<S> form_;  // empty: TSEP-list stiffness
+    Colouring form_col_;
     // Gather lists: vertex -> incident edges (side-encoded), edge -> incoming
     // TSEPs (E0, L(P)), edge -> incoming stiffness contributions.
     std::vector<index_t> inc_first_, inc_;
@@ -105,13 +117,23 @@ inline void atomic_add(T* base, std::size_t i, T v) {
 
 template <class S>
 ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<const Executor> executor,
-                                            Variant variant, const PlanOptions& opts)
+                                            Variant variant, const PlanOptions& opts, TetEdgeForm<S> form)
     : m_(std::move(model)),
       ex_(executor ? std::move(executor) : std::make_shared<SerialExecutor>()),
       variant_(variant),
       range_chunk_(std::max<index_t>(1, opts.range_chunk)),
-      parts_(std::max(1, ex_->threads())) {
+      parts_(std::max(1, ex_->threads())),
+      form_(std::move(form)) {
     const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    if (form_.num_tets > 0) {
+        if (form_.num_edges != ne) throw InvalidArgument("tet-local form and edge model belong to different meshes");
+        m_.target = {};  // the TSEP-list stiffness plan is not needed
+        const auto& f = form_;
+        form_col_ = colour_items(f.num_batches(), ne, [&f](index_t b, std::vector<index_t>& out) {
+            for (int k = 0; k < 6; ++k)
+                for (int l = 0; l < f.batch_size(b); ++l) out.push_back(f.edge[(std::size_t(b) * 6 + k) * kTetLanes + l]);
+        }, opts.form_colouring);
+    }
     switch (variant_) {
         case Variant::Colour: {
             edge_col_ = colour_edges(m_, opts.edge_colouring);
@@ -187,7 +209,7 @@ template <class S>
 std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
     auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
     std::size_t b = 0;
-    for (const Colouring* c : {&edge_col_, &tsep_col_, &stiff_col_})
+    for (const Colouring* c : {&edge_col_, &tsep_col_, &stiff_col_, &form_col_})
         b += bytes(c->units) + bytes(c->colour_first) + bytes(c->chunk_first) + bytes(c->chunk_units);
     b += bytes(inc_first_) + bytes(inc_) + bytes(tin_first_) + bytes(tin_e0_) + bytes(tin_L_) + bytes(kin_first_) +
          bytes(kin_);
@@ -296,6 +318,14 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
     const double* g = st.g.data();
     S* K = Ks.K.data();
     const auto& m = m_;
+    if (Kind == ModelKind::FE && tet_local_stiffness()) {
+        each_range(ne, [&](index_t b, index_t e) {
+            for (index_t i = b; i < e; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
+        });
+        // Only the last batch has padding lanes, so one chunk writes the sink.
+        par::for_colours(*ex_, form_col_, [&](index_t b, index_t) { kernel::tet_form_stiffness(form_, b, p, K); });
+        return;
+    }
     if (Kind == ModelKind::FE && variant_ == Variant::Gather) {  // one pass: K(E) = edge term + its TSEP terms
         each_range(ne, [&](index_t b, index_t e) {
             for (index_t i = b; i < e; ++i) {

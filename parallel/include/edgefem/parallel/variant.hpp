@@ -3,6 +3,7 @@
 
 #include <string_view>
 
+#include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/parallel/colouring.hpp"
 
 namespace edgefem {
@@ -32,10 +33,22 @@ inline ColouringOptions blocked_colouring() {
     return o;
 }
 
+inline ColouringOptions form_batch_colouring() {
+    ColouringOptions o;
+    o.block = 8;
+    o.max_chunk_items = 256;
+    o.min_chunk_items = 8;
+    return o;
+}
+
 struct PlanOptions {
     ColouringOptions edge_colouring = blocked_colouring();     // edge scatter (forces, K x, diagonal)
     ColouringOptions segment_colouring = blocked_colouring();  // TSEP segments (g, K)
     ColouringOptions tet_colouring;      // per-tet scatter
+    // FE stiffness from the tet-local form (default) or the TSEP list, and
+    // the colouring of the form's 8-tet batches (units of 8 batches).
+    StiffnessLayout stiffness_layout = StiffnessLayout::TetLocal;
+    ColouringOptions form_colouring = form_batch_colouring();
     index_t range_chunk = 2048;          // items per chunk of the uncoloured loops
     bool stiffness = true;               // build what the stiffness kernels need
 };

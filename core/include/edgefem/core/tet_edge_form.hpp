@@ -1,0 +1,222 @@
+// The tet-local form of the edge-based model: per tet, the global ids of its
+// 6 edges and the off-diagonal part of the symmetric 6x6 form A(T) whose
+// sums over tets are L(P) (formulation.md section 4). The diagonal, summed
+// into L(E), stays with the edges: the edge loops add L(E) zeta to g and
+// -2 L(E) p~ p~^T to K(E) as before, and A_kk reaches no other block.
+//
+// Why a second form: the mesh-wide TSEP list scatters every pair's 3x3 block
+// into 4 targets (~36 block read-modify-writes per tet). Per tet, the 6
+// off-diagonal blocks of the Hessian are
+//     K_ab = 2 sum_{k ni a} sum_{l ni b} s_ka s_lb A_kl p~_k p~_l^T
+// (s_ka = +1 when a is V0 of edge k, -1 when it is V1), computed in
+// registers and scattered once each: 6 block updates per tet.
+//
+// Layout: tets in batches of kTetLanes, structure-of-arrays inside a batch,
+// so the per-tet arithmetic runs across the batch's tets in SIMD lanes;
+// tets sorted by their vertices, so neighbouring tets update neighbouring
+// K(E) blocks.
+// Each tet's vertices are taken in ascending global order, so every local
+// edge (i < j) runs the way its global edge does (V0 < V1): no transposes.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/material.hpp"
+#include "edgefem/core/mesh.hpp"
+#include "edgefem/core/topology.hpp"
+
+namespace edgefem {
+
+inline constexpr int kTetLanes = 8;
+
+// Row of A_kl in a batch: the upper triangle without the diagonal, row by
+// row; the diagonal reads row 15, which holds zeros (so the kernels stay
+// plain loops over all 6 x 6).
+inline constexpr int kFormRows = 16;
+inline constexpr int kSym[6][6] = {{15, 0, 1, 2, 3, 4},  {0, 15, 5, 6, 7, 8},   {1, 5, 15, 9, 10, 11},
+                                   {2, 6, 9, 15, 12, 13}, {3, 7, 10, 12, 15, 14}, {4, 8, 11, 13, 14, 15}};
+// The 3 local edges at each local vertex, and the vertex's sign in them
+// (+1: the edge's first end, p~ = x_first - x_second).
+inline constexpr int kVertexEdges[4][3] = {{0, 1, 2}, {0, 3, 4}, {1, 3, 5}, {2, 4, 5}};
+inline constexpr int kVertexSigns[4][3] = {{1, 1, 1}, {-1, 1, 1}, {-1, -1, 1}, {-1, -1, -1}};
+
+template <class S>
+struct TetEdgeForm {
+    index_t num_tets = 0;
+    index_t num_edges = 0;
+    // Batch b, local edge k, lane l: edge[(b * 6 + k) * kTetLanes + l]. Lanes
+    // past num_tets in the last batch hold edge 0 and A = 0.
+    std::vector<index_t> edge;
+    // A[(b * kFormRows + kSym[k][l]) * kTetLanes + lane].
+    std::vector<S> A;
+    // The tet in each slot (batch * kTetLanes + lane), for inspection only:
+    // the kernels never read it. Tets are stored sorted by their vertices.
+    std::vector<index_t> slot_tet;
+
+    index_t num_batches() const { return (num_tets + kTetLanes - 1) / kTetLanes; }
+    index_t batch_size(index_t b) const { return std::min<index_t>(kTetLanes, num_tets - b * kTetLanes); }
+    double bytes_per_tet() const {
+        return num_tets > 0 ? double(edge.size() * sizeof(index_t) + A.size() * sizeof(S)) / num_tets : 0.0;
+    }
+};
+
+// Throws InvalidArgument for an invalid material.
+template <class S>
+TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const Materials& materials);
+
+namespace kernel {
+
+// Adds each tet's share of sum_{F != E} A_EF zeta(F) to g(E) for batch b
+// (g in double whatever S is, as EdgeState::g).
+template <class S>
+inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g) {
+    constexpr int L = kTetLanes;
+    const index_t* E = &f.edge[std::size_t(b) * 6 * L];
+    const S* A = &f.A[std::size_t(b) * kFormRows * L];
+    double Z[6][L], G[6][L];
+    for (int k = 0; k < 6; ++k)
+        for (int l = 0; l < L; ++l) Z[k][l] = double(zeta[E[k * L + l]]);
+    for (int k = 0; k < 6; ++k)
+        for (int l = 0; l < L; ++l) {
+            double s = 0;
+            for (int m = 0; m < 6; ++m) s += double(A[kSym[k][m] * L + l]) * Z[m][l];
+            G[k][l] = s;
+        }
+    const int n = f.batch_size(b);
+    for (int l = 0; l < n; ++l)
+        for (int k = 0; k < 6; ++k) g[E[k * L + l]] += G[k][l];
+}
+
+// blk[l][x] += kv[x][l] for the L lanes and 9 values of a block. In float,
+// 4 x 4 transposes in registers turn 9 scalar updates per lane into two
+// 4-wide ones and one scalar (37 -> 30 ns/tet on bunny-4k); in double the
+// 32-byte updates of 72-byte blocks straddle cache lines and lose (50 -> 58),
+// so double stays scalar.
+template <class V, class S>
+inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes]) {
+    if constexpr (sizeof(S) != 4) {
+        for (int x = 0; x < 9; ++x)
+#pragma GCC unroll 8
+            for (int l = 0; l < kTetLanes; ++l) blk[l][x] += kv[x][l];
+        return;
+    }
+    typedef S V4 __attribute__((vector_size(sizeof(S) * 4)));
+    auto add4 = [](S* dst, V4 v) {
+        V4 d;
+        __builtin_memcpy(&d, dst, sizeof(V4));
+        d += v;
+        __builtin_memcpy(dst, &d, sizeof(V4));
+    };
+    static_assert(kTetLanes == 8);
+#pragma GCC unroll 2
+    for (int h = 0; h < 2; ++h) {
+        V4 r[8];
+        for (int x = 0; x < 8; ++x)
+            r[x] = h == 0 ? __builtin_shufflevector(kv[x], kv[x], 0, 1, 2, 3) : __builtin_shufflevector(kv[x], kv[x], 4, 5, 6, 7);
+#pragma GCC unroll 2
+        for (int q = 0; q < 2; ++q) {  // values 4q .. 4q + 3
+            const V4 t0 = __builtin_shufflevector(r[4 * q], r[4 * q + 1], 0, 4, 1, 5);
+            const V4 t1 = __builtin_shufflevector(r[4 * q], r[4 * q + 1], 2, 6, 3, 7);
+            const V4 t2 = __builtin_shufflevector(r[4 * q + 2], r[4 * q + 3], 0, 4, 1, 5);
+            const V4 t3 = __builtin_shufflevector(r[4 * q + 2], r[4 * q + 3], 2, 6, 3, 7);
+            add4(blk[4 * h] + 4 * q, __builtin_shufflevector(t0, t2, 0, 1, 4, 5));
+            add4(blk[4 * h + 1] + 4 * q, __builtin_shufflevector(t0, t2, 2, 3, 6, 7));
+            add4(blk[4 * h + 2] + 4 * q, __builtin_shufflevector(t1, t3, 0, 1, 4, 5));
+            add4(blk[4 * h + 3] + 4 * q, __builtin_shufflevector(t1, t3, 2, 3, 6, 7));
+        }
+    }
+#pragma GCC unroll 8
+    for (int l = 0; l < kTetLanes; ++l) blk[l][8] += kv[8][l];
+}
+
+// Adds each tet's share of the 6 off-diagonal Hessian blocks, less the edge
+// terms, to K(E) (row-major 3x3 per edge, #E + 1 blocks: the last is the
+// sink) for batch b, from the current edge vectors p~ (3 #E).
+template <class S>
+inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __restrict p, S* __restrict K) {
+    constexpr int L = kTetLanes;
+    // One value per lane in a register: the blocks are scattered straight
+    // from registers (a stack array written as vectors and re-read per lane
+    // stalls every read on store forwarding: measured 2x slower).
+    typedef S V __attribute__((vector_size(sizeof(S) * L)));
+    const index_t* E = &f.edge[std::size_t(b) * 6 * L];
+    const S* A = &f.A[std::size_t(b) * kFormRows * L];
+    auto row = [&](int k, int m) {
+        V v;
+        __builtin_memcpy(&v, &A[kSym[k][m] * L], sizeof(V));
+        return v;
+    };
+    V P[6][3];
+    for (int k = 0; k < 6; ++k)
+        for (int c = 0; c < 3; ++c)
+            for (int l = 0; l < L; ++l) P[k][c][l] = p[3 * std::size_t(E[k * L + l]) + c];
+    // W[k][v] = sum over the edges m at vertex v of s_mv A_km p~_m.
+    V W[6][4][3];
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k)
+#pragma GCC unroll 4
+        for (int v = 0; v < 4; ++v) {
+            const int m0 = kVertexEdges[v][0], m1 = kVertexEdges[v][1], m2 = kVertexEdges[v][2];
+            const V a0 = S(kVertexSigns[v][0]) * row(k, m0), a1 = S(kVertexSigns[v][1]) * row(k, m1),
+                    a2 = S(kVertexSigns[v][2]) * row(k, m2);
+            for (int c = 0; c < 3; ++c) W[k][v][c] = a0 * P[m0][c] + a1 * P[m1][c] + a2 * P[m2][c];
+        }
+    // K_ab = 2 sum over the edges k at a of s_ka p~_k W[k][b]^T. Padding
+    // lanes of the last batch write the sink block K(#E).
+    const int n = f.batch_size(b);
+    S* const sink = &K[9 * std::size_t(f.num_edges)];
+#pragma GCC unroll 6
+    for (int e = 0; e < 6; ++e) {
+        const int a = kTetEdge[e][0], bv = kTetEdge[e][1];
+        const int k0 = kVertexEdges[a][0], k1 = kVertexEdges[a][1], k2 = kVertexEdges[a][2];
+        const S s0 = S(2 * kVertexSigns[a][0]), s1 = S(2 * kVertexSigns[a][1]), s2 = S(2 * kVertexSigns[a][2]);
+        S* blk[L];
+        for (int l = 0; l < L; ++l) blk[l] = l < n ? &K[9 * std::size_t(E[e * L + l])] : sink;
+        V kv[9];
+        for (int i = 0; i < 3; ++i) {
+            const V x0 = s0 * P[k0][i], x1 = s1 * P[k1][i], x2 = s2 * P[k2][i];
+            for (int j = 0; j < 3; ++j) kv[3 * i + j] = x0 * W[k0][bv][j] + x1 * W[k1][bv][j] + x2 * W[k2][bv][j];
+        }
+        scatter_blocks(kv, blk);
+    }
+}
+
+}  // namespace kernel
+
+// ---- Serial loops: edge_forces / edge_stiffness_all with the TSEP loop
+// replaced by the tet-local form (same results up to summation order). ----
+
+template <ModelKind Kind, bool Energy, class S>
+double tet_form_forces(const EdgeModel<S>& m, const TetEdgeForm<S>& form, const S* u, S* f, EdgeState<S>& st) {
+    const index_t ne = m.num_edges();
+    st.resize(ne);
+    for (index_t e = 0; e < ne; ++e) kernel::edge_strain(m, u, e, st.p.data(), st.zeta.data(), st.g.data());
+    if constexpr (Kind == ModelKind::FE)
+        for (index_t b = 0; b < form.num_batches(); ++b) kernel::tet_form_strain(form, b, st.zeta.data(), st.g.data());
+    std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
+    for (index_t a = 0; a < m.num_vertices; ++a) kernel::edge_force_segment(m, a, st.p.data(), st.g.data(), f);
+    double W = 0;
+    if constexpr (Energy)
+        for (index_t e = 0; e < ne; ++e) W += double(st.zeta[e]) * st.g[e];
+    return 0.25 * W;
+}
+
+template <ModelKind Kind, bool Definite = false, class S>
+void tet_form_stiffness_all(const EdgeModel<S>& m, const TetEdgeForm<S>& form, const EdgeState<S>& st,
+                            EdgeStiffness<S>& K) {
+    const index_t ne = m.num_edges();
+    if (K.K.size() != 9 * (std::size_t(ne) + 1)) K.resize(ne);
+    for (index_t e = 0; e < ne; ++e) kernel::edge_stiffness<Definite>(m, e, st.p.data(), st.g.data(), K.K.data());
+    if constexpr (Kind == ModelKind::FE)
+        for (index_t b = 0; b < form.num_batches(); ++b) kernel::tet_form_stiffness(form, b, st.p.data(), K.K.data());
+}
+
+extern template struct TetEdgeForm<double>;
+extern template struct TetEdgeForm<float>;
+extern template TetEdgeForm<double> make_tet_edge_form<double>(const Mesh&, const Topology&, const Materials&);
+extern template TetEdgeForm<float> make_tet_edge_form<float>(const Mesh&, const Topology&, const Materials&);
+
+}  // namespace edgefem
