@@ -29,6 +29,7 @@
 #include "edgefem/core/validate_mesh.hpp"
 #ifdef EDGEFEM_HAPTIC_HAVE_PARALLEL
 #include "edgefem/parallel/executors.hpp"
+#include "edgefem/parallel/async_tangent.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
 #endif
 
@@ -49,6 +50,7 @@ struct Options {
     std::string precision = "double";
     std::string model = "fe";
     int stiffness_interval = 1;  // build K every N steps (a lagged tangent)
+    bool async_tangent = false;  // build K on a background thread, swap it in when ready
     std::string backend = "serial";
     int threads = 0;
     double force = 0.2;  // N, spread over the probed vertices
@@ -63,7 +65,7 @@ struct Options {
 [[noreturn]] void usage(const char* msg) {
     std::fprintf(stderr,
                  "edgefem_haptic_loop: %s\nusage: edgefem_haptic_loop [--mesh PATH|box:NXxNYxNZ] [--seconds S] "
-                 "[--rate HZ] [--cg-iters N] [--stiffness-interval N] [--precision double|float] [--model fe|sn] "
+                 "[--rate HZ] [--cg-iters N] [--stiffness-interval N] [--async-tangent] [--precision double|float] [--model fe|sn] "
                  "[--backend serial|omp|tbb] [--threads N] [--force N] [--young PA] [--alpha 1/S] [--indefinite] [--free-run] [--gravity G]\n",
                  msg);
     std::exit(2);
@@ -84,6 +86,7 @@ Options parse(int argc, char** argv) {
         else if (a == "--precision") o.precision = next();
         else if (a == "--model") o.model = next();
         else if (a == "--stiffness-interval") o.stiffness_interval = std::atoi(next().c_str());
+        else if (a == "--async-tangent") o.async_tangent = true;
         else if (a == "--backend") o.backend = next();
         else if (a == "--threads") o.threads = std::atoi(next().c_str());
         else if (a == "--force") o.force = std::atof(next().c_str());
@@ -209,8 +212,12 @@ int run(const Options& o) {
         backend = executor->name();
         threads = executor->threads();
     }
+    // The tangent on a background thread (the second core), K swapped in
+    // when ready; the loop's thread only computes forces and runs CG.
+    if (o.async_tangent) factory = async_tangent_factory<S>(factory);
 #else
     if (o.backend != "serial") usage("this build has no parallel module: --backend serial only");
+    if (o.async_tangent) usage("this build has no parallel module: no --async-tangent");
 #endif
     Simulator<S> sim(std::move(scene), executor, factory);
     const Mesh& mesh = sim.scene().mesh;
@@ -221,7 +228,7 @@ int run(const Options& o) {
                 o.precision.c_str(), backend.c_str(), threads);
     std::printf("young_pa: %g\nrayleigh_alpha: %g\ndefinite_stiffness: %s\n", o.young, o.alpha,
                 o.definite ? "true" : "false");
-    std::printf("stiffness_interval: %d\n", o.stiffness_interval);
+    std::printf("stiffness_interval: %d\nasync_tangent: %s\n", o.stiffness_interval, o.async_tangent ? "true" : "false");
     std::printf("cg_fixed_iterations: %d\nrate_hz: %g\nbudget_ms: %g\nprobe_force_n: %g\n", o.cg_iters, o.rate,
                 1e3 / o.rate, o.force);
 

@@ -47,14 +47,28 @@ void for_blocks(const Executor& ex, std::size_t n, Body&& body) {
 }
 
 // Sum over [0, n) of term(i): per-block partial sums, added in block order.
+// Inside a block, 8 interleaved accumulators combined pairwise: a single
+// running sum waits one add latency per term (a CG dot product over
+// armadillo-7k took 12% of a semi-implicit step), 8 of them vectorise. The
+// order depends on n only, so the sum is the same for any thread count.
 template <class Term>
 double blocked_sum(const Executor& ex, std::size_t n, Term&& term) {
     const std::size_t chunks = (n + kVectorChunk - 1) / kVectorChunk;
     std::vector<double> partial(chunks, 0.0);
     for_blocks(ex, n, [&](std::size_t b, std::size_t e) {
-        double s = 0;
-        for (std::size_t i = b; i < e; ++i) s += term(i);
-        partial[b / kVectorChunk] = s;
+        // Vector types spelled out: with a plain a[8] g++ 12 vectorises the
+        // outer loop instead and shuffles every term.
+        typedef double V4 __attribute__((vector_size(32)));
+        V4 s0 = {0, 0, 0, 0}, s1 = {0, 0, 0, 0};
+        std::size_t i = b;
+        for (; i + 8 <= e; i += 8) {
+            s0 += V4{term(i), term(i + 1), term(i + 2), term(i + 3)};
+            s1 += V4{term(i + 4), term(i + 5), term(i + 6), term(i + 7)};
+        }
+        double tail = 0;
+        for (; i < e; ++i) tail += term(i);
+        const V4 s = s0 + s1;
+        partial[b / kVectorChunk] = ((s[0] + s[1]) + (s[2] + s[3])) + tail;
     });
     double s = 0;
     for (double p : partial) s += p;
