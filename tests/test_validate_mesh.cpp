@@ -185,20 +185,13 @@ TEST(validate_mesh_quality, SharedMeshesMatchReadme) {
 }
 
 // The 1M-tet bunny validates well under a second (Release build).
-TEST(validate_mesh, MillionTetsIsFast) {
+// The largest shared mesh reads and validates clean (its speed is measured
+// in bench_topology's validate/bunny-1m, not here).
+TEST(validate_mesh, MillionTetMeshValidates) {
     const std::string prefix = test::shared_mesh_prefix("bunny-1m");
     if (prefix.empty()) GTEST_SKIP() << "bunny-1m not found under " << test::shared_mesh_dir();
-    const auto t0 = std::chrono::steady_clock::now();
     Mesh m = read_tetgen(prefix);
-    const auto t1 = std::chrono::steady_clock::now();
     const ValidationReport r = validate_mesh(m);
-    const auto t2 = std::chrono::steady_clock::now();
-    const double read_s = std::chrono::duration<double>(t1 - t0).count();
-    const double validate_s = std::chrono::duration<double>(t2 - t1).count();
-    std::printf("bunny-1m: read %.3f s, validate %.3f s\n", read_s, validate_s);
     EXPECT_EQ(m.num_tets(), 1003465);
     EXPECT_EQ(r.unreferenced_vertices, 0);
-#ifdef NDEBUG
-    EXPECT_LT(validate_s, 1.0);
-#endif
 }
