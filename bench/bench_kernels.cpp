@@ -4,6 +4,7 @@
 // per_tet counter is seconds per tet (shown as ns).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -19,7 +20,7 @@ using namespace edgefem;
 namespace {
 
 enum class Kernel { Force, Stiffness, ForceStiffness, Kx };
-enum class Method { EdgeFE, EdgeFETetForm, EdgeSN, Tet };
+enum class Method { EdgeFE, EdgeFE3Pass, EdgeFETetForm, EdgeSN, Tet };
 
 const char* name_of(Kernel k) {
     switch (k) {
@@ -32,6 +33,7 @@ const char* name_of(Kernel k) {
 const char* name_of(Method m) {
     switch (m) {
         case Method::EdgeFE: return "edge-fe";
+        case Method::EdgeFE3Pass: return "edge-fe-3pass";
         case Method::EdgeFETetForm: return "edge-fe-tetform";
         case Method::EdgeSN: return "edge-sn";
         default: return "tet";
@@ -89,6 +91,26 @@ void run_edge(benchmark::State& state, const Prepared<S>& p, Kernel k) {
     }
 }
 
+// The unfused FE force of before the TSEP loop and the scatter were fused
+// (edge loop, TSEP loop, scatter loop over core's workers): the baseline the
+// fused edge_forces is measured against in the same run. Force only.
+template <class S>
+void run_edge_3pass(benchmark::State& state, const Prepared<S>& p) {
+    const EdgeModel<S>& m = p.edge;
+    std::vector<S> f(p.u.size());
+    EdgeState<S> st;
+    const index_t ne = m.num_edges();
+    st.resize(ne);
+    for (auto _ : state) {
+        for (index_t e = 0; e < ne; ++e) kernel::edge_strain(m, p.u.data(), e, st.p.data(), st.zeta.data(), st.g.data());
+        for (index_t e = 0; e < ne; ++e) kernel::tsep_strain_segment(m, e, st.zeta.data(), st.g.data());
+        std::fill(f.begin(), f.end(), S(0));
+        for (index_t a = 0; a < m.num_vertices; ++a) kernel::edge_force_segment(m, a, st.p.data(), st.g.data(), f.data());
+        benchmark::DoNotOptimize(f.data());
+        benchmark::ClobberMemory();
+    }
+}
+
 // The edge-based FE model with the tet-local form instead of the TSEP list.
 template <class S>
 void run_tet_form(benchmark::State& state, const Prepared<S>& p, Kernel k) {
@@ -136,6 +158,8 @@ void BM_Kernel(benchmark::State& state, std::string mesh, Method m, Kernel k) {
     const Prepared<S>& p = prepared<S>(mesh);
     if (m == Method::EdgeFE)
         run_edge<ModelKind::FE>(state, p, k);
+    else if (m == Method::EdgeFE3Pass)
+        run_edge_3pass(state, p);
     else if (m == Method::EdgeFETetForm)
         run_tet_form(state, p, k);
     else if (m == Method::EdgeSN)
@@ -152,8 +176,9 @@ int main(int argc, char** argv) {
     benchmark::Initialize(&argc, argv);
     for (const char* mesh : bench::kBenchMeshes)
         for (Kernel k : {Kernel::Force, Kernel::Stiffness, Kernel::ForceStiffness, Kernel::Kx})
-            for (Method m : {Method::EdgeFE, Method::EdgeFETetForm, Method::EdgeSN, Method::Tet})
+            for (Method m : {Method::EdgeFE, Method::EdgeFE3Pass, Method::EdgeFETetForm, Method::EdgeSN, Method::Tet})
                 for (int precision = 0; precision < 2; ++precision) {
+                    if (m == Method::EdgeFE3Pass && k != Kernel::Force) continue;
                     const std::string name = std::string(name_of(k)) + "/" + name_of(m) + "/" +
                                              (precision ? "float" : "double") + "/" + mesh;
                     auto* b = precision ? benchmark::RegisterBenchmark(name.c_str(), BM_Kernel<float>, mesh, m, k)

@@ -74,20 +74,31 @@ namespace kernel {
 template <class S>
 inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g) {
     constexpr int L = kTetLanes;
+    // Lanes in registers, as in tet_form_stiffness (no stack round trip).
+    typedef double V __attribute__((vector_size(sizeof(double) * L)));
     const index_t* E = &f.edge[std::size_t(b) * 6 * L];
     const S* A = &f.A[std::size_t(b) * kFormRows * L];
-    double Z[6][L], G[6][L];
+    V Z[6];
     for (int k = 0; k < 6; ++k)
         for (int l = 0; l < L; ++l) Z[k][l] = double(zeta[E[k * L + l]]);
-    for (int k = 0; k < 6; ++k)
-        for (int l = 0; l < L; ++l) {
-            double s = 0;
-            for (int m = 0; m < 6; ++m) s += double(A[kSym[k][m] * L + l]) * Z[m][l];
-            G[k][l] = s;
-        }
     const int n = f.batch_size(b);
-    for (int l = 0; l < n; ++l)
-        for (int k = 0; k < 6; ++k) g[E[k * L + l]] += G[k][l];
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) {
+        V s = {};
+#pragma GCC unroll 6
+        for (int m = 0; m < 6; ++m) {
+            if (m == k) continue;  // the diagonal stays with the edges (L(E))
+            V a;
+            for (int l = 0; l < L; ++l) a[l] = double(A[kSym[k][m] * L + l]);
+            s += a * Z[m];
+        }
+        if (n == L) {
+#pragma GCC unroll 8
+            for (int l = 0; l < L; ++l) g[E[k * L + l]] += s[l];
+        } else {
+            for (int l = 0; l < n; ++l) g[E[k * L + l]] += s[l];
+        }
+    }
 }
 
 // blk[l][x] += kv[x][l] for the L lanes and 9 values of a block. In float,
