@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/core/tet_kernels.hpp"
 
 namespace edgefem::flops {
@@ -73,10 +74,11 @@ inline TetModel<Counted> counted_model(const TetModel<double>& m) {
 struct Measured {
     std::int64_t edge_force_fe = 0, edge_force_sn = 0, edge_stiffness_fe = 0, edge_stiffness_sn = 0, edge_kx = 0;
     std::int64_t tet_force = 0, tet_stiffness = 0, tet_kx = 0;
+    std::int64_t edge_stiffness_fe_tet_local = 0;  // FE stiffness from the tet-local form (when given)
 };
 
 inline Measured count_kernels(const EdgeModel<double>& edge_d, const TetModel<double>& tet_d,
-                              const std::vector<double>& u_d) {
+                              const std::vector<double>& u_d, const TetEdgeForm<double>* form_d = nullptr) {
     const EdgeModel<Counted> em = counted_model(edge_d);
     const TetModel<Counted> tm = counted_model(tet_d);
     std::vector<Counted> u(u_d.begin(), u_d.end()), f(u.size()), y(u.size()), x(u.size());
@@ -94,6 +96,10 @@ inline Measured count_kernels(const EdgeModel<double>& edge_d, const TetModel<do
     r.edge_force_fe = count([&] { edge_forces<ModelKind::FE, false>(em, u.data(), f.data(), st); });
     r.edge_stiffness_fe = count([&] { edge_stiffness_all<ModelKind::FE>(em, st, K); });
     r.edge_kx = count([&] { edge_multiply(em, K, x.data(), y.data()); });
+    if (form_d) {
+        const TetEdgeForm<Counted> form = convert_scalar<Counted>(*form_d);
+        r.edge_stiffness_fe_tet_local = count([&] { tet_form_stiffness_all<ModelKind::FE>(em, form, st, K); });
+    }
     TetStiffness<Counted> Kt;
     r.tet_force = count([&] { tet_forces<false>(tm, u.data(), f.data()); });
     r.tet_stiffness = count([&] { tet_stiffness_all(tm, u.data(), Kt); });

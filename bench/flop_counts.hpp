@@ -15,7 +15,10 @@
 // adds the double part by hand.
 #pragma once
 
+#include <cmath>
+
 #include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 
 namespace edgefem::flops {
 
@@ -34,6 +37,11 @@ inline constexpr long kVertexForce = 3;
 inline constexpr long kEdgeStiffness = 28;
 // tsep_stiffness_segment, per TSEP: c = 2 L(P) 1; 4 targets x (cs x_i 3 + 9 (mul + add)).
 inline constexpr long kTsepStiffness = 85;
+// tet_form_stiffness, per lane of a batch (every batch runs all kTetLanes
+// lanes; padding lanes of the last batch compute zeros): signed rows of A
+// 6 x 4 x 3 = 72; W 6 x 4 x 3 x (3 mul + 2 add) = 360; per local edge: signed
+// p~ 9, 9 entries x (3 mul + 2 add) = 45, 9 updates; x 6 edges = 378.
+inline constexpr long kTetFormStiffnessPerLane = 72 + 360 + 6 * (9 + 45 + 9);
 // edge_kx_segment, per edge: d 3; 3 rows x 2 ends x (3 mul + 2 add + 1 update);
 // per vertex: y(a) -= acc 3.
 inline constexpr long kEdgeKx = 39;
@@ -75,6 +83,13 @@ inline Count edge_force(const Items& n, ModelKind kind) {
 // Edge-based stiffness (from the state of a force call).
 inline Count edge_stiffness(const Items& n, ModelKind kind) {
     const double v = n.E * kEdgeStiffness + (kind == ModelKind::FE ? n.P * kTsepStiffness : 0.0);
+    return {v, v};
+}
+// FE stiffness from the tet-local form (the default layout): the edge terms,
+// then every lane of every 8-tet batch.
+inline Count edge_stiffness_tet_local(const Items& n) {
+    const double lanes = std::ceil(n.T / kTetLanes) * kTetLanes;
+    const double v = n.E * kEdgeStiffness + lanes * kTetFormStiffnessPerLane;
     return {v, v};
 }
 inline Count edge_kx(const Items& n) {

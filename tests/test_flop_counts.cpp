@@ -25,13 +25,15 @@ TEST(FlopCounts, HandFormulasMatchTheCountingScalarExactly) {
         const EdgeModel<double> em = make_edge_model<double>(topo, compute_coefficients(nm.mesh, topo, mat));
         const TetModel<double> tm = make_tet_model<double>(nm.mesh, mat);
         const std::vector<double> u = deformation_displacement(nm.mesh, Deformation::Twist);
-        const flops::Measured got = flops::count_kernels(em, tm, u);
+        const TetEdgeForm<double> form = make_tet_edge_form<double>(nm.mesh, topo, mat);
+        const flops::Measured got = flops::count_kernels(em, tm, u, &form);
         const flops::Items n = flops::items_of(em);
         EXPECT_EQ(double(got.edge_force_fe), flops::edge_force(n, ModelKind::FE).counted);
         EXPECT_EQ(double(got.edge_force_sn), flops::edge_force(n, ModelKind::SN).counted);
         EXPECT_EQ(double(got.edge_stiffness_fe), flops::edge_stiffness(n, ModelKind::FE).counted);
         EXPECT_EQ(double(got.edge_stiffness_sn), flops::edge_stiffness(n, ModelKind::SN).counted);
         EXPECT_EQ(double(got.edge_kx), flops::edge_kx(n).counted);
+        EXPECT_EQ(double(got.edge_stiffness_fe_tet_local), flops::edge_stiffness_tet_local(n).counted);
         // The counting scalar executes the energy arithmetic the source always
         // computes (with_energy = true).
         EXPECT_EQ(double(got.tet_force), flops::tet_force(n, true).counted);

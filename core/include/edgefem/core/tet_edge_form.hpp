@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 #include "edgefem/core/coefficients.hpp"
@@ -63,11 +64,62 @@ struct TetEdgeForm {
     }
 };
 
+// The same form in another scalar type (e.g. the operation-counting one).
+template <class To, class From>
+TetEdgeForm<To> convert_scalar(const TetEdgeForm<From>& f) {
+    TetEdgeForm<To> c;
+    c.num_tets = f.num_tets;
+    c.num_edges = f.num_edges;
+    c.edge = f.edge;
+    c.A.assign(f.A.begin(), f.A.end());
+    c.slot_tet = f.slot_tet;
+    return c;
+}
+
 // Throws InvalidArgument for an invalid material.
 template <class S>
 TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const Materials& materials);
 
 namespace kernel {
+
+// kTetLanes values of S, one per tet of a batch: a GCC/Clang vector for
+// built-in scalars (the arithmetic runs in SIMD registers), and for other
+// scalars (the operation-counting scalar of bench/counting_scalar.hpp) an
+// array with the same element-wise operators, so the same kernel source
+// runs on both.
+template <class S>
+struct LaneArray {
+    S v[kTetLanes] = {};
+    S& operator[](int l) { return v[l]; }
+    const S& operator[](int l) const { return v[l]; }
+    friend LaneArray operator+(const LaneArray& a, const LaneArray& b) {
+        LaneArray r;
+        for (int l = 0; l < kTetLanes; ++l) r.v[l] = a.v[l] + b.v[l];
+        return r;
+    }
+    friend LaneArray operator*(const LaneArray& a, const LaneArray& b) {
+        LaneArray r;
+        for (int l = 0; l < kTetLanes; ++l) r.v[l] = a.v[l] * b.v[l];
+        return r;
+    }
+    friend LaneArray operator*(const S& a, const LaneArray& b) {
+        LaneArray r;
+        for (int l = 0; l < kTetLanes; ++l) r.v[l] = a * b.v[l];
+        return r;
+    }
+    LaneArray& operator+=(const LaneArray& b) {
+        for (int l = 0; l < kTetLanes; ++l) v[l] += b.v[l];
+        return *this;
+    }
+};
+template <class S, bool = std::is_arithmetic_v<S>>
+struct Lanes {
+    typedef S type __attribute__((vector_size(sizeof(S) * kTetLanes)));
+};
+template <class S>
+struct Lanes<S, false> {
+    using type = LaneArray<S>;
+};
 
 // Adds each tet's share of sum_{F != E} A_EF zeta(F) to g(E) for batch b
 // (g in double whatever S is, as EdgeState::g).
@@ -108,39 +160,39 @@ inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restr
 // so double stays scalar.
 template <class V, class S>
 inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes]) {
-    if constexpr (sizeof(S) != 4) {
+    if constexpr (!std::is_same_v<S, float>) {
         for (int x = 0; x < 9; ++x)
 #pragma GCC unroll 8
             for (int l = 0; l < kTetLanes; ++l) blk[l][x] += kv[x][l];
-        return;
-    }
-    typedef S V4 __attribute__((vector_size(sizeof(S) * 4)));
-    auto add4 = [](S* dst, V4 v) {
-        V4 d;
-        __builtin_memcpy(&d, dst, sizeof(V4));
-        d += v;
-        __builtin_memcpy(dst, &d, sizeof(V4));
-    };
-    static_assert(kTetLanes == 8);
+    } else {
+        typedef S V4 __attribute__((vector_size(sizeof(S) * 4)));
+        auto add4 = [](S* dst, V4 v) {
+            V4 d;
+            __builtin_memcpy(&d, dst, sizeof(V4));
+            d += v;
+            __builtin_memcpy(dst, &d, sizeof(V4));
+        };
+        static_assert(kTetLanes == 8);
 #pragma GCC unroll 2
-    for (int h = 0; h < 2; ++h) {
-        V4 r[8];
-        for (int x = 0; x < 8; ++x)
-            r[x] = h == 0 ? __builtin_shufflevector(kv[x], kv[x], 0, 1, 2, 3) : __builtin_shufflevector(kv[x], kv[x], 4, 5, 6, 7);
+        for (int h = 0; h < 2; ++h) {
+            V4 r[8];
+            for (int x = 0; x < 8; ++x)
+                r[x] = h == 0 ? __builtin_shufflevector(kv[x], kv[x], 0, 1, 2, 3) : __builtin_shufflevector(kv[x], kv[x], 4, 5, 6, 7);
 #pragma GCC unroll 2
-        for (int q = 0; q < 2; ++q) {  // values 4q .. 4q + 3
-            const V4 t0 = __builtin_shufflevector(r[4 * q], r[4 * q + 1], 0, 4, 1, 5);
-            const V4 t1 = __builtin_shufflevector(r[4 * q], r[4 * q + 1], 2, 6, 3, 7);
-            const V4 t2 = __builtin_shufflevector(r[4 * q + 2], r[4 * q + 3], 0, 4, 1, 5);
-            const V4 t3 = __builtin_shufflevector(r[4 * q + 2], r[4 * q + 3], 2, 6, 3, 7);
-            add4(blk[4 * h] + 4 * q, __builtin_shufflevector(t0, t2, 0, 1, 4, 5));
-            add4(blk[4 * h + 1] + 4 * q, __builtin_shufflevector(t0, t2, 2, 3, 6, 7));
-            add4(blk[4 * h + 2] + 4 * q, __builtin_shufflevector(t1, t3, 0, 1, 4, 5));
-            add4(blk[4 * h + 3] + 4 * q, __builtin_shufflevector(t1, t3, 2, 3, 6, 7));
+            for (int q = 0; q < 2; ++q) {  // values 4q .. 4q + 3
+                const V4 t0 = __builtin_shufflevector(r[4 * q], r[4 * q + 1], 0, 4, 1, 5);
+                const V4 t1 = __builtin_shufflevector(r[4 * q], r[4 * q + 1], 2, 6, 3, 7);
+                const V4 t2 = __builtin_shufflevector(r[4 * q + 2], r[4 * q + 3], 0, 4, 1, 5);
+                const V4 t3 = __builtin_shufflevector(r[4 * q + 2], r[4 * q + 3], 2, 6, 3, 7);
+                add4(blk[4 * h] + 4 * q, __builtin_shufflevector(t0, t2, 0, 1, 4, 5));
+                add4(blk[4 * h + 1] + 4 * q, __builtin_shufflevector(t0, t2, 2, 3, 6, 7));
+                add4(blk[4 * h + 2] + 4 * q, __builtin_shufflevector(t1, t3, 0, 1, 4, 5));
+                add4(blk[4 * h + 3] + 4 * q, __builtin_shufflevector(t1, t3, 2, 3, 6, 7));
+            }
         }
-    }
 #pragma GCC unroll 8
-    for (int l = 0; l < kTetLanes; ++l) blk[l][8] += kv[8][l];
+        for (int l = 0; l < kTetLanes; ++l) blk[l][8] += kv[8][l];
+    }
 }
 
 // Adds each tet's share of the 6 off-diagonal Hessian blocks, less the edge
@@ -152,12 +204,12 @@ inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __re
     // One value per lane in a register: the blocks are scattered straight
     // from registers (a stack array written as vectors and re-read per lane
     // stalls every read on store forwarding: measured 2x slower).
-    typedef S V __attribute__((vector_size(sizeof(S) * L)));
+    using V = typename Lanes<S>::type;
     const index_t* E = &f.edge[std::size_t(b) * 6 * L];
     const S* A = &f.A[std::size_t(b) * kFormRows * L];
     auto row = [&](int k, int m) {
         V v;
-        __builtin_memcpy(&v, &A[kSym[k][m] * L], sizeof(V));
+        for (int l = 0; l < L; ++l) v[l] = A[kSym[k][m] * L + l];
         return v;
     };
     V P[6][3];
