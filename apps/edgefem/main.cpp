@@ -50,12 +50,13 @@ int main(int argc, char** argv) {
     edgefem::cli::add_static_command(app);
     edgefem::cli::add_stress_command(app);
     edgefem::cli::add_accuracy_command(app);
+    edgefem::cli::add_bench_layouts_command(app);
     // CLI11 would report a mistyped subcommand as "A subcommand is required".
     if (argc > 1 && argv[1][0] != '-') {
         bool known = false;
         for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
             known = known || sub->get_name() == argv[1];
-        if (!known) return fail(std::string("unknown subcommand '") + argv[1] + "' (expected info, forces, bench, simulate, static, stress or accuracy)");
+        if (!known) return fail(std::string("unknown subcommand '") + argv[1] + "' (expected info, forces, bench, bench-layouts, simulate, static, stress or accuracy)");
     }
     try {
         app.parse(argc, argv);  // runs the selected subcommand's callback

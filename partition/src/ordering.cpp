@@ -187,11 +187,18 @@ std::vector<index_t> nested_dissection(const Mesh& mesh) {
     return std::vector<index_t>(iperm.begin(), iperm.end());  // iperm[old] = new
 }
 
-std::vector<index_t> metis_kway(const Mesh& mesh, const OrderingOptions& opt) {
+PartitionedOrdering one_part(std::vector<index_t> new_of_old) {
+    PartitionedOrdering r;
+    r.part_first = {0, static_cast<index_t>(new_of_old.size())};
+    r.new_of_old = std::move(new_of_old);
+    return r;
+}
+
+PartitionedOrdering metis_kway(const Mesh& mesh, const OrderingOptions& opt) {
     const index_t nv = mesh.num_vertices();
     const double parts = std::ceil(nv * opt.bytes_per_vertex / double(opt.part_bytes));
-    const std::vector<index_t> inner = rcm(mesh);
-    if (parts < 2) return inner;
+    std::vector<index_t> inner = rcm(mesh);
+    if (parts < 2) return one_part(std::move(inner));
     std::vector<index_t> off, adj;
     vertex_graph(mesh, off, adj);
     idx_t n = nv, ncon = 1, nparts = static_cast<idx_t>(parts), objval = 0;
@@ -215,7 +222,13 @@ std::vector<index_t> metis_kway(const Mesh& mesh, const OrderingOptions& opt) {
         if (part[a] != part[b]) return mean[part[a]] != mean[part[b]] ? mean[part[a]] < mean[part[b]] : part[a] < part[b];
         return inner[a] < inner[b];
     });
-    return from_order(order);
+    PartitionedOrdering r;
+    r.part_first.push_back(0);
+    for (index_t k = 1; k < nv; ++k)
+        if (part[order[k]] != part[order[k - 1]]) r.part_first.push_back(k);
+    r.part_first.push_back(nv);
+    r.new_of_old = from_order(order);
+    return r;
 }
 
 }  // namespace
@@ -231,8 +244,23 @@ std::vector<index_t> vertex_ordering(const Mesh& mesh, Ordering kind, const Orde
         case Ordering::RCM: return rcm(mesh);
         case Ordering::Morton: return morton(mesh);
         case Ordering::NestedDissection: return nested_dissection(mesh);
-        default: return metis_kway(mesh, options);
+        default: return metis_kway(mesh, options).new_of_old;
     }
+}
+
+PartitionedOrdering vertex_ordering_with_parts(const Mesh& mesh, Ordering kind, const OrderingOptions& options) {
+    if (kind == Ordering::MetisKway) return metis_kway(mesh, options);
+    return one_part(vertex_ordering(mesh, kind, options));
+}
+
+std::vector<index_t> vertex_parts(const std::vector<index_t>& part_first) {
+    if (part_first.empty() || part_first.front() != 0) throw InvalidArgument("vertex_parts: part_first must start at 0");
+    std::vector<index_t> out(std::size_t(part_first.back()));
+    for (std::size_t p = 0; p + 1 < part_first.size(); ++p) {
+        if (part_first[p + 1] < part_first[p]) throw InvalidArgument("vertex_parts: part_first decreases");
+        std::fill(out.begin() + part_first[p], out.begin() + part_first[p + 1], static_cast<index_t>(p));
+    }
+    return out;
 }
 
 Bandwidth ordering_bandwidth(const Mesh& mesh, const std::vector<index_t>& new_of_old, index_t window) {

@@ -35,6 +35,25 @@ struct OrderingOptions {
 // new_of_old[v] = the new index of vertex v (a permutation of 0..#V-1).
 std::vector<index_t> vertex_ordering(const Mesh& mesh, Ordering kind, const OrderingOptions& options = {});
 
+// A vertex ordering together with the parts it numbers contiguously. For
+// MetisKway: the METIS k-way parts, part p = the new vertex numbers
+// [part_first[p], part_first[p + 1]) (parts in the order the ordering
+// visits them, empty parts dropped); every other ordering, and a metis
+// ordering of a mesh small enough for one part, gives one part. new_of_old is
+// exactly vertex_ordering(mesh, kind, options). Partition-aware colouring
+// turns the parts into edge units (units_from_vertex_parts, part_colouring in
+// parallel/colouring.hpp).
+struct PartitionedOrdering {
+    std::vector<index_t> new_of_old;
+    std::vector<index_t> part_first;  // #parts + 1 offsets into the new numbering
+    index_t num_parts() const { return part_first.empty() ? 0 : static_cast<index_t>(part_first.size() - 1); }
+};
+PartitionedOrdering vertex_ordering_with_parts(const Mesh& mesh, Ordering kind, const OrderingOptions& options = {});
+
+// The part of every vertex (new numbering) from part_first: out[v] = p for
+// part_first[p] <= v < part_first[p + 1].
+std::vector<index_t> vertex_parts(const std::vector<index_t>& part_first);
+
 // The vertex graph (vertices adjacent when they share a tet edge) as CSR.
 void vertex_graph(const Mesh& mesh, std::vector<index_t>& offsets, std::vector<index_t>& adjacency);
 

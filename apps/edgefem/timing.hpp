@@ -1,0 +1,47 @@
+// Wall-clock timing of repeated calls for the benchmarking subcommands: a
+// warm-up, then timed calls, one steady_clock reading each, medians.
+// (`edgefem bench` in cmd_bench.cpp has its own copy of the same helper;
+// it can switch to this one.)
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cstddef>
+#include <vector>
+
+namespace edgefem::cli {
+
+// Calls `call` for a warm-up (caches, page faults, clock ramp-up: 5% of the
+// budget, at least one call), then until `seconds` have passed and at least
+// `min_calls` calls were timed; returns the timed calls' durations in ns,
+// sorted.
+template <class Call>
+std::vector<double> time_calls(double seconds, Call&& call, std::size_t min_calls = 5) {
+    using clock = std::chrono::steady_clock;
+    const auto budget = std::chrono::duration<double>(seconds);
+    for (const auto w0 = clock::now();;) {
+        call();
+        if (clock::now() - w0 >= 0.05 * budget) break;
+    }
+    std::vector<double> ns;
+    for (const auto start = clock::now(); ns.size() < min_calls || clock::now() - start < budget;) {
+        const auto t0 = clock::now();
+        call();
+        const auto t1 = clock::now();
+        ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
+    }
+    std::sort(ns.begin(), ns.end());
+    return ns;
+}
+
+inline double median_of_sorted(const std::vector<double>& v) {
+    const std::size_t n = v.size();
+    if (n == 0) return 0;
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Tells the compiler that the memory behind p is read, so the stores of a
+// timed call cannot be dropped.
+inline void escape(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
+
+}  // namespace edgefem::cli
