@@ -1,6 +1,9 @@
 // `edgefem bench MESH --kernel K`: times one kernel on the twist
 // configuration, or one semi-implicit time step, one steady_clock reading per
-// call.
+// call. For the edge method's force and kx kernels it also reports the bytes
+// a call moves from memory (compulsory traffic, stream_bandwidth.hpp) and the
+// rate that makes; --stream measures the STREAM bandwidth on the same
+// executor in the same run and prints the kernel's fraction of it.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -10,10 +13,13 @@
 
 #include "common.hpp"
 #include "edgefem/core/benchmark_scene.hpp"
+#include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
+#include "edgefem/core/topology.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
+#include "edgefem/parallel/stream_bandwidth.hpp"
 
 namespace edgefem::cli {
 
@@ -26,6 +32,7 @@ struct BenchOptions {
     std::string kernel;
     double seconds = 1.0;
     int cg_iters = 0;  // step: > 0 runs exactly this many CG iterations
+    bool stream = false;  // also measure the STREAM bandwidth on the same executor
 };
 
 const std::map<std::string, Kernel> kKernels = {{"force", Kernel::Force},
@@ -102,8 +109,33 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     print_kv("cg_iterations_max", *std::max_element(iterations.begin(), iterations.end()));
 }
 
+// Bytes one call of `kernel` moves (compulsory and per-pass counts,
+// stream_bandwidth.hpp), from an edge model built for the purpose and freed
+// before the timed one is built; {0, 0} where no model applies (per-tet
+// method, stiffness, force+stiffness).
+struct Traffic {
+    double compulsory = 0, per_pass = 0;
+};
+
+template <class S>
+Traffic kernel_traffic_as(const BenchOptions& opts, const Mesh& mesh, Kernel kernel) {
+    const Topology topo = build_topology(mesh);
+    const EdgeModel<S> m = make_edge_model<S>(topo, compute_coefficients(mesh, topo, opts.model.material));
+    if (kernel == Kernel::Force)
+        return {force_bytes_per_call(m, opts.model.kind(), TrafficModel::Compulsory),
+                force_bytes_per_call(m, opts.model.kind(), TrafficModel::PerPass)};
+    return {kx_bytes_per_call(m, TrafficModel::Compulsory), kx_bytes_per_call(m, TrafficModel::PerPass)};
+}
+
+Traffic kernel_traffic(const BenchOptions& opts, const Mesh& mesh, Kernel kernel) {
+    if (opts.model.method_kind() != Method::Edge || (kernel != Kernel::Force && kernel != Kernel::Kx)) return {};
+    return opts.model.precision_kind() == Precision::Float ? kernel_traffic_as<float>(opts, mesh, kernel)
+                                                           : kernel_traffic_as<double>(opts, mesh, kernel);
+}
+
 void run_bench(const BenchOptions& opts) {
     opts.model.validate();
+    if (opts.stream && opts.kernel == "step") throw InvalidArgument("--stream does not apply to --kernel step");
     if (opts.cg_iters > 0 && opts.kernel != "step") throw InvalidArgument("--cg-iters applies only to --kernel step");
     LoadedMesh lm = load_mesh(opts.mesh);
     for (const auto& w : load_warnings(lm)) std::fprintf(stderr, "edgefem: warning: %s\n", w.c_str());
@@ -116,6 +148,7 @@ void run_bench(const BenchOptions& opts) {
     }
     const Kernel kernel = kKernels.at(opts.kernel);
     const Mesh& mesh = lm.mesh;
+    const Traffic traffic = kernel_traffic(opts, mesh, kernel);
 
     auto eval = make_evaluator(mesh, opts.model, opts.exec);
     eval->set_displacement(deformation_displacement(mesh, Deformation::Twist));
@@ -128,6 +161,10 @@ void run_bench(const BenchOptions& opts) {
     });
     const double median = median_of_sorted(ns);
     const double tets = mesh.num_tets();
+    // After the timed calls, on the kernels' executor (same back-end and
+    // threads), with the kernel's data still allocated.
+    StreamBandwidth stream;
+    if (opts.stream) stream = measure_stream_bandwidth(*opts.exec.executor());
 
     print_header(opts, mesh);
     print_kv("calls", ns.size());
@@ -135,6 +172,28 @@ void run_bench(const BenchOptions& opts) {
     print_kv("min_ms", fmt(ns.front() * 1e-6, 6));
     print_kv("median_ns_per_tet", fmt(median / tets, 6));
     print_kv("min_ns_per_tet", fmt(ns.front() / tets, 6));
+    const double achieved = traffic.compulsory / median;  // bytes per ns = GB/s
+    if (traffic.compulsory > 0) {
+        print_kv("bytes_per_call", fmt(traffic.compulsory, 10));
+        print_kv("achieved_GB_per_s", fmt(achieved, 6));
+        print_kv("bytes_per_call_per_pass", fmt(traffic.per_pass, 10));
+        print_kv("achieved_GB_per_s_per_pass", fmt(traffic.per_pass / median, 6));
+    }
+    if (opts.stream) {
+        print_kv("stream_threads", stream.threads);
+        print_kv("stream_copy_GB_per_s", fmt(stream.copy, 6));
+        print_kv("stream_scale_GB_per_s", fmt(stream.scale, 6));
+        print_kv("stream_add_GB_per_s", fmt(stream.add, 6));
+        print_kv("stream_triad_GB_per_s", fmt(stream.triad, 6));
+        print_kv("stream_sum_GB_per_s", fmt(stream.sum, 6));
+        print_kv("stream_triad_best_GB_per_s", fmt(stream.triad_best, 6));
+        if (traffic.compulsory > 0) {
+            print_kv("fraction_of_stream", fmt(achieved / stream.triad, 4));
+            // Fastest call against fastest triad: the least disturbed pair on
+            // a shared machine (STREAM itself reports best times).
+            print_kv("fraction_of_stream_best", fmt(traffic.compulsory / ns.front() / stream.triad_best, 4));
+        }
+    }
 }
 
 }  // namespace
@@ -144,7 +203,8 @@ void add_bench_command(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "bench",
         "Time one kernel on the twist configuration, or one time step, on the chosen back-end (--backend, --threads, --variant): a warm-up, then "
-        "calls until --seconds have passed (at least 5); reports the median and minimum per call and per tet");
+        "calls until --seconds have passed (at least 5); reports the median and minimum per call and per tet, and for the edge method's force and kx the "
+        "bytes a call moves from memory (bytes_per_call) and the rate achieved (achieved_GB_per_s)");
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/false);
     add_exec_options(*cmd, opts->exec);
@@ -156,6 +216,10 @@ void add_bench_command(CLI::App& app) {
                     "--cg-iters iterations), successive steps from the moving state")
         ->required()
         ->check(CLI::IsMember({"force", "stiffness", "force+stiffness", "kx", "step"}));
+    cmd->add_flag("--stream", opts->stream,
+                  "Also measure the STREAM bandwidth (copy, scale, add, triad, read-only sum; 3 x 64 MiB, median of 7) "
+                  "on the same back-end and threads after the timed calls, and print the kernel's fraction of the "
+                  "triad rate (edge force and kx: bytes_per_call / median time)");
     cmd->add_option("--cg-iters", opts->cg_iters,
                     "step: run exactly N warm-started CG iterations per step instead of solving to 1e-6")
         ->check(CLI::PositiveNumber);
