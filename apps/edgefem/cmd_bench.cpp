@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "timing.hpp"
 #include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
@@ -39,33 +40,6 @@ const std::map<std::string, Kernel> kKernels = {{"force", Kernel::Force},
                                                 {"stiffness", Kernel::Stiffness},
                                                 {"force+stiffness", Kernel::ForceStiffness},
                                                 {"kx", Kernel::Kx}};
-
-// Calls `call` for a warm-up (caches, page faults, clock ramp-up: 5% of the
-// budget, at least one call), then until `seconds` have passed (at least 5
-// calls); returns the timed calls' durations in ns, sorted.
-template <class Call>
-std::vector<double> time_calls(double seconds, Call call) {
-    using clock = std::chrono::steady_clock;
-    const auto budget = std::chrono::duration<double>(seconds);
-    for (const auto w0 = clock::now(); ;) {
-        call();
-        if (clock::now() - w0 >= 0.05 * budget) break;
-    }
-    std::vector<double> ns;
-    for (const auto start = clock::now(); ns.size() < 5 || clock::now() - start < budget;) {
-        const auto t0 = clock::now();
-        call();
-        const auto t1 = clock::now();
-        ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
-    }
-    std::sort(ns.begin(), ns.end());
-    return ns;
-}
-
-double median_of_sorted(const std::vector<double>& v) {
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 void print_header(const BenchOptions& opts, const Mesh& mesh) {
     print_kv("mesh", opts.mesh.path);

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "timing.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
@@ -10,10 +11,6 @@
 namespace edgefem::cli {
 
 namespace {
-
-// Tells the compiler that the memory behind p is read, so the stores of a
-// timed call cannot be dropped.
-inline void escape(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
 
 // Any elastic model (edge FE/SN or per-tet; serial or parallel kernels)
 // through its ElasticOperator; doubles at the interface, the kernel's scalar

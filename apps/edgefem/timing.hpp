@@ -1,7 +1,6 @@
-// Wall-clock timing of repeated calls for the benchmarking subcommands: a
-// warm-up, then timed calls, one steady_clock reading each, medians.
-// (`edgefem bench` in cmd_bench.cpp has its own copy of the same helper;
-// it can switch to this one.)
+// Wall-clock timing of repeated calls for the benchmarking subcommands
+// (`bench`, `bench-layouts`, and the evaluators' escape): a warm-up, then
+// timed calls, one steady_clock reading each, medians.
 #pragma once
 
 #include <algorithm>
