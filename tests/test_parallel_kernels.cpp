@@ -15,6 +15,7 @@
 #include "edgefem/parallel/parallel_tet_kernels.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
+#include "write_sets.hpp"
 
 using namespace edgefem;
 using edgefem::test::rel_diff;
@@ -199,19 +200,9 @@ TEST(Colourings, ConflictFree) {
         const auto& m = models.edge;
         // Independent write sets, from the topology rather than the model.
         const Topology& topo = models.topo;
-        const ResourceFn edge_w = [&](index_t e, std::vector<index_t>& out) {
-            out.push_back(topo.edges[e][0]);
-            out.push_back(topo.edges[e][1]);
-        };
-        const ResourceFn tsep_w = [&](index_t e0, std::vector<index_t>& out) {
-            out.push_back(e0);
-            for (index_t P = topo.first_tsep[e0]; P < topo.first_tsep[e0 + 1]; ++P) out.push_back(topo.tseps[P][1]);
-        };
-        const ResourceFn stiff_w = [&](index_t e0, std::vector<index_t>& out) {
-            for (index_t P = topo.first_tsep[e0]; P < topo.first_tsep[e0 + 1]; ++P)
-                for (Target t : topo.tsep_targets[P])
-                    if (t != kDiagonalTarget) out.push_back(target_edge(t));
-        };
+        const ResourceFn edge_w = test::edge_write_set(topo);
+        const ResourceFn tsep_w = test::tsep_strain_write_set(topo);
+        const ResourceFn stiff_w = test::tsep_stiffness_write_set(topo);
         const ResourceFn tet_w = [&](index_t t, std::vector<index_t>& out) {
             for (int k = 0; k < 4; ++k) out.push_back(nm.mesh.tets[4 * std::size_t(t) + k]);
         };

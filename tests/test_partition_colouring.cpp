@@ -22,6 +22,7 @@
 #include "edgefem/partition/permute_mesh.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
+#include "write_sets.hpp"
 
 using namespace edgefem;
 using edgefem::test::rel_diff;
@@ -201,19 +202,9 @@ TEST(PartitionColouring, ConflictFreeAndCoverEveryItemOnce) {
         const auto& m = models.edge;
         const Topology& topo = models.topo;
         // Independent write sets, from the topology rather than the model.
-        const ResourceFn edge_w = [&](index_t e, std::vector<index_t>& out) {
-            out.push_back(topo.edges[e][0]);
-            out.push_back(topo.edges[e][1]);
-        };
-        const ResourceFn tsep_w = [&](index_t e0, std::vector<index_t>& out) {
-            out.push_back(e0);
-            for (index_t P = topo.first_tsep[e0]; P < topo.first_tsep[e0 + 1]; ++P) out.push_back(topo.tseps[P][1]);
-        };
-        const ResourceFn stiff_w = [&](index_t e0, std::vector<index_t>& out) {
-            for (index_t P = topo.first_tsep[e0]; P < topo.first_tsep[e0 + 1]; ++P)
-                for (Target t : topo.tsep_targets[P])
-                    if (t != kDiagonalTarget) out.push_back(target_edge(t));
-        };
+        const ResourceFn edge_w = test::edge_write_set(topo);
+        const ResourceFn tsep_w = test::tsep_strain_write_set(topo);
+        const ResourceFn stiff_w = test::tsep_stiffness_write_set(topo);
         for (bool balance : {true, false}) {
             ColouringOptions base;
             base.balance = balance;
