@@ -42,7 +42,8 @@ TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const 
         for (int i = 0; i < 4; ++i)
             for (int r = 0; r < 3; ++r) g.a[i][r] = g0.a[perm[i]][r];
         double A[6][6];
-        tet_edge_form(g, materials.of(mesh.tet_region(t)).lambda(), materials.of(mesh.tet_region(t)).mu(), A);
+        const Material& mat = materials.of(mesh.tet_region(t));
+        tet_edge_form(g, mat.lambda(), mat.mu(), A);
         const auto& te = topo.tet_edges[t];
         for (int k = 0; k < 6; ++k) {
             const index_t a = v[perm[kTetEdge[k][0]]], c = v[perm[kTetEdge[k][1]]];

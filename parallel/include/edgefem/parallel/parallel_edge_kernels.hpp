@@ -318,15 +318,7 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
     const double* g = st.g.data();
     S* K = Ks.K.data();
     const auto& m = m_;
-    if (Kind == ModelKind::FE && tet_local_stiffness()) {
-        each_range(ne, [&](index_t b, index_t e) {
-            for (index_t i = b; i < e; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
-        });
-        // Only the last batch has padding lanes, so one chunk writes the sink.
-        par::for_colours(*ex_, form_col_, [&](index_t b, index_t) { kernel::tet_form_stiffness(form_, b, p, K); });
-        return;
-    }
-    if (Kind == ModelKind::FE && variant_ == Variant::Gather) {  // one pass: K(E) = edge term + its TSEP terms
+    if (Kind == ModelKind::FE && !tet_local_stiffness() && variant_ == Variant::Gather) {  // one pass: K(E) = edge term + its TSEP terms
         each_range(ne, [&](index_t b, index_t e) {
             for (index_t i = b; i < e; ++i) {
                 kernel::edge_stiffness<Definite>(m, i, p, g, K);
@@ -339,6 +331,11 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
         for (index_t i = b; i < e; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
     });
     if constexpr (Kind == ModelKind::FE) {
+        if (tet_local_stiffness()) {
+            // Only the last batch has padding lanes, so one chunk writes the sink.
+            par::for_colours(*ex_, form_col_, [&](index_t b, index_t) { kernel::tet_form_stiffness(form_, b, p, K); });
+            return;
+        }
         switch (variant_) {
             case Variant::Colour:
                 par::for_colours(*ex_, stiff_col_, [&](index_t e0, index_t) { kernel::tsep_stiffness_segment(m, e0, p, K); });
