@@ -9,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <type_traits>
 #include <vector>
 
 #include "edgefem/core/edge_model.hpp"
@@ -211,27 +212,77 @@ inline void edge_kx(const EdgeModel<S>& m, index_t e, const S* __restrict K, con
     }
 }
 
+// One vertex's xyz as the first three lanes of a 4-lane vector (lane 3
+// zero), and back: two loads / stores that never touch the next vertex.
+template <class S>
+struct Xyz4 {
+    typedef S V __attribute__((vector_size(4 * sizeof(S))));
+    static V load(const S* p) {
+        V v = {p[0], p[1], p[2], S(0)};
+        return v;
+    }
+    static void store(S* p, V v) {
+        p[0] = v[0];
+        p[1] = v[1];
+        p[2] = v[2];
+    }
+    // Row r of a row-major 3x3 block as lanes 0..2 (lane 3 reads the next
+    // value: K blocks are followed by a sink block, so it is in bounds, and
+    // it only ever meets a zero lane).
+    static V row(const S* k) {
+        V v;
+        __builtin_memcpy(&v, k, sizeof v);
+        return v;
+    }
+};
+
 // K x over the segment of edges whose V0 is `a` (y(a) accumulated in
-// registers, as in edge_force_segment).
+// registers, as in edge_force_segment). Built-in scalars run it in 4-lane
+// vectors: K(E)^T d as three row-times-broadcast FMAs, K(E) d as lane-wise
+// products summed once per segment (half the scalar version's operations).
 template <class S>
 inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
                             S* __restrict y) {
-    const S xa0 = x[3 * std::size_t(a)], xa1 = x[3 * std::size_t(a) + 1], xa2 = x[3 * std::size_t(a) + 2];
-    S acc0 = 0, acc1 = 0, acc2 = 0;
-    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
-        const index_t b = m.edge[e][1];
-        const S* k = &K[9 * std::size_t(e)];
-        const S d0 = xa0 - x[3 * std::size_t(b)], d1 = xa1 - x[3 * std::size_t(b) + 1], d2 = xa2 - x[3 * std::size_t(b) + 2];
-        acc0 += k[0] * d0 + k[1] * d1 + k[2] * d2;
-        acc1 += k[3] * d0 + k[4] * d1 + k[5] * d2;
-        acc2 += k[6] * d0 + k[7] * d1 + k[8] * d2;
-        y[3 * std::size_t(b)] += k[0] * d0 + k[3] * d1 + k[6] * d2;
-        y[3 * std::size_t(b) + 1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
-        y[3 * std::size_t(b) + 2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
+    if constexpr (std::is_floating_point_v<S>) {
+        using X = Xyz4<S>;
+        using V = typename X::V;
+        const V xa = X::load(&x[3 * std::size_t(a)]);
+        V r0 = {}, r1 = {}, r2 = {};
+        for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
+            const std::size_t b = 3 * std::size_t(m.edge[e][1]);
+            const S* k = &K[9 * std::size_t(e)];
+            const V d = xa - X::load(&x[b]);
+            const V k0 = X::row(k), k1 = X::row(k + 3), k2 = X::row(k + 6);
+            r0 += k0 * d;
+            r1 += k1 * d;
+            r2 += k2 * d;
+            // y(V1) is summed into last: its chain through memory (the next
+            // segment often updates the same vertex) stays one add long.
+            const V t = d[0] * k0 + d[1] * k1 + d[2] * k2;
+            X::store(&y[b], X::load(&y[b]) + t);
+        }
+        S* ya = &y[3 * std::size_t(a)];
+        ya[0] -= r0[0] + r0[1] + r0[2];
+        ya[1] -= r1[0] + r1[1] + r1[2];
+        ya[2] -= r2[0] + r2[1] + r2[2];
+    } else {
+        const S xa0 = x[3 * std::size_t(a)], xa1 = x[3 * std::size_t(a) + 1], xa2 = x[3 * std::size_t(a) + 2];
+        S acc0 = 0, acc1 = 0, acc2 = 0;
+        for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
+            const index_t b = m.edge[e][1];
+            const S* k = &K[9 * std::size_t(e)];
+            const S d0 = xa0 - x[3 * std::size_t(b)], d1 = xa1 - x[3 * std::size_t(b) + 1], d2 = xa2 - x[3 * std::size_t(b) + 2];
+            acc0 += k[0] * d0 + k[1] * d1 + k[2] * d2;
+            acc1 += k[3] * d0 + k[4] * d1 + k[5] * d2;
+            acc2 += k[6] * d0 + k[7] * d1 + k[8] * d2;
+            y[3 * std::size_t(b)] += k[0] * d0 + k[3] * d1 + k[6] * d2;
+            y[3 * std::size_t(b) + 1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
+            y[3 * std::size_t(b) + 2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
+        }
+        y[3 * std::size_t(a)] -= acc0;
+        y[3 * std::size_t(a) + 1] -= acc1;
+        y[3 * std::size_t(a) + 2] -= acc2;
     }
-    y[3 * std::size_t(a)] -= acc0;
-    y[3 * std::size_t(a) + 1] -= acc1;
-    y[3 * std::size_t(a) + 2] -= acc2;
 }
 
 // Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
