@@ -36,10 +36,11 @@ void BM(benchmark::State& state, std::string name, int threads, index_t block, i
         op = make_elastic_operator<double>(mesh, mat, ModelKind::FE, Method::Edge);
     } else {
         PlanOptions o;
-        for (ColouringOptions* c : {&o.edge_colouring, &o.segment_colouring}) {
-            c->block = block;
-            c->max_chunk_items = std::max<index_t>(1024, 4 * block);
-        }
+        // Vertex segments hold ~6 edges each: 1/6 of the block in vertices.
+        o.segment_colouring.block = block;
+        o.segment_colouring.max_chunk_items = std::max<index_t>(1024, 4 * block);
+        o.vertex_colouring.block = std::max<index_t>(1, block / 6);
+        o.vertex_colouring.max_chunk_items = std::max<index_t>(170, (4 * block) / 6);
         op = make_parallel_operator<double>(mesh, mat, ModelKind::FE, Method::Edge, make_executor(Backend::TBB, threads),
                                             Variant::Colour, o);
     }

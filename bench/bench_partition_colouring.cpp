@@ -84,11 +84,11 @@ PlanOptions plan(const Prepared& p, Units units) {
     PlanOptions o;
     o.stiffness = false;  // force and K x only (K x takes core's K)
     if (units == Units::B1) {
-        o.edge_colouring = o.segment_colouring = ColouringOptions{};
+        o.vertex_colouring = o.segment_colouring = ColouringOptions{};
     } else if (units == Units::Parts) {
-        o.edge_colouring = part_colouring(p.model, p.part_first, blocked_colouring());
-        o.segment_colouring = o.edge_colouring;
-    }  // B1024: PlanOptions' default, blocked_colouring()
+        o.vertex_colouring = part_vertex_colouring(p.part_first, blocked_vertex_colouring());
+        o.segment_colouring = part_colouring(p.model, p.part_first, blocked_colouring());
+    }  // B1024: PlanOptions' defaults (segments: blocked_colouring(), vertices: blocked_vertex_colouring())
     return o;
 }
 
@@ -128,7 +128,7 @@ void BM(benchmark::State& state, std::string name, int kernel, Backend backend, 
                 k.multiply(p.K, p.x.data(), y.data());
             benchmark::ClobberMemory();
         }
-        const Colouring& ce = k.edge_colouring();
+        const Colouring& ce = k.vertex_colouring();
         state.counters["colours"] = ce.colours();
         state.counters["units"] = double(ce.num_units());
         state.counters["seg_colours"] = k.tsep_colouring().colours();

@@ -26,6 +26,33 @@ TEST(Executors, EveryChunkOnce) {
             }
 }
 
+// Phases: every (phase, chunk) once, and no call of a phase starts before
+// every call of the previous phase has finished (the barrier the coloured
+// scatter relies on).
+TEST(Executors, PhasesRunOnceAndInOrder) {
+    const std::vector<index_t> chunks{3, 0, 1, 16, 2, 5};
+    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB})
+        for (int t : {1, 2, 3, 8})
+            for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
+                const auto ex = make_executor(b, t, s);
+                std::vector<std::vector<std::atomic<int>>> hits;
+                for (index_t n : chunks) hits.emplace_back(n);
+                std::vector<std::atomic<int>> done(chunks.size());
+                std::atomic<int> out_of_order{0};
+                ex->for_phases(chunks, [&](int p, index_t c) {
+                    for (int q = 0; q < p; ++q)
+                        if (done[q].load() != int(chunks[q])) out_of_order.fetch_add(1);
+                    volatile double x = 0;  // a little work so that calls overlap
+                    for (int i = 0; i < 2000; ++i) x = x + i;
+                    hits[p][c].fetch_add(1);
+                    done[p].fetch_add(1);
+                });
+                EXPECT_EQ(out_of_order.load(), 0) << to_string(b) << t;
+                for (std::size_t p = 0; p < chunks.size(); ++p)
+                    for (index_t c = 0; c < chunks[p]; ++c) EXPECT_EQ(hits[p][c].load(), 1) << to_string(b) << t;
+            }
+}
+
 TEST(Executors, BlockedSumIndependentOfThreads) {
     const std::size_t n = 100003;
     std::vector<double> a(n);
@@ -45,7 +72,7 @@ TEST(Executors, Names) {
     EXPECT_EQ(parse_backend("tbb"), Backend::TBB);
     EXPECT_THROW(parse_backend("cuda"), InvalidArgument);
     for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB}) EXPECT_EQ(parse_backend(to_string(b)), b);
-    for (Variant v : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private})
+    for (Variant v : kAllVariants)
         EXPECT_EQ(parse_variant(to_string(v)), v);
     EXPECT_EQ(parse_variant("color"), Variant::Colour);
     EXPECT_THROW(parse_variant("mutex"), InvalidArgument);

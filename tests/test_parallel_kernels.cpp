@@ -152,7 +152,7 @@ void check_edge_kernels(double core_tol) {
         if (Kind == ModelKind::FE) form = make_tet_edge_form<S>(nm.mesh, models.topo, Materials(Material{1e5, 0.3, 1000}));
         for (bool tet_local : {false, true}) {
             if (tet_local && Kind != ModelKind::FE) continue;
-            for (Variant v : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private}) {
+            for (Variant v : kAllVariants) {
                 const std::string tag = nm.name + "/" + to_string(v) + (tet_local ? "/tet-local" : "");
                 const TetEdgeForm<S>& fm = tet_local ? form : TetEdgeForm<S>{};
                 const Outputs<S> serial = run_parallel<Kind>(models.edge, std::make_shared<SerialExecutor>(), v, u, x, {}, fm);
@@ -184,7 +184,7 @@ TEST(ParallelEdgeKernels, BlockedColouringsDeterministic) {
     const auto u = deformation_displacement(nm.mesh, Deformation::Twist);
     const auto x = deformation_displacement(nm.mesh, Deformation::Random);
     PlanOptions opts;
-    opts.edge_colouring.block = 8;
+    opts.vertex_colouring.block = 3;
     opts.segment_colouring.block = 4;
     opts.segment_colouring.balance = false;
     const auto core = run_core<ModelKind::FE>(models.edge, u, x);
@@ -194,6 +194,59 @@ TEST(ParallelEdgeKernels, BlockedColouringsDeterministic) {
         expect_bitwise(run_parallel<ModelKind::FE>(models.edge, ne.ex, Variant::Colour, u, x, opts), serial, ne.name);
 }
 
+// Owner variant with many small parts (the default gives the small test
+// meshes a single part): every part spills, and the results are still
+// bitwise the same for every thread count and close to core.
+TEST(ParallelEdgeKernels, OwnerPartsSpillAndStayDeterministic) {
+    for (const auto& nm : meshes()) {
+        if (nm.mesh.num_vertices() < 40) continue;
+        const auto models = edgefem::test::make_models<double>(nm.mesh);
+        const auto u = deformation_displacement(nm.mesh, Deformation::Twist);
+        const auto x = deformation_displacement(nm.mesh, Deformation::Random);
+        const auto core = run_core<ModelKind::FE>(models.edge, u, x);
+        const auto form = make_tet_edge_form<double>(nm.mesh, models.topo, Materials(Material{1e5, 0.3, 1000}));
+        for (index_t parts : {2, 7, 13}) {
+            PlanOptions opts;
+            opts.owner_parts = parts;
+            const std::string tag = nm.name + "/owner-" + std::to_string(parts);
+            const ParallelEdgeKernels<double> probe(models.edge, std::make_shared<SerialExecutor>(), Variant::Owner, opts);
+            EXPECT_EQ(probe.vertex_parts().parts(), parts) << tag;
+            EXPECT_GT(probe.vertex_parts().spill_targets(), 0u) << tag;
+            EXPECT_GT(probe.edge_parts().spill_targets(), 0u) << tag;
+            for (bool tet_local : {false, true}) {
+                const TetEdgeForm<double>& fm = tet_local ? form : TetEdgeForm<double>{};
+                const auto serial = run_parallel<ModelKind::FE>(models.edge, std::make_shared<SerialExecutor>(),
+                                                                Variant::Owner, u, x, opts, fm);
+                expect_close(serial, core, 1e-12, tag + "/serial vs core");
+                for (const auto& ne : executors())
+                    expect_bitwise(run_parallel<ModelKind::FE>(models.edge, ne.ex, Variant::Owner, u, x, opts, fm), serial,
+                                   tag + "/" + ne.name);
+            }
+        }
+    }
+}
+
+TEST(ForwardSpill, WindowsAndConsumers) {
+    // 10 items in parts {0..2}, {3..5}, {6..9}; item i writes up to last[i].
+    const std::vector<index_t> last{1, 4, 2, 3, 8, 5, 6, 9, 8, 9};
+    const std::vector<index_t> parts{0, 3, 6, 10};
+    const ForwardSpill fs = make_forward_spill(10, parts, [&](index_t i) { return last[i]; });
+    ASSERT_EQ(fs.parts(), 3);
+    EXPECT_EQ(fs.window_end, (std::vector<index_t>{5, 9, 10}));
+    EXPECT_EQ(fs.spill_targets(), std::size_t(2 + 3 + 0));
+    // Part 1 reads part 0's window; part 2 reads part 1's (part 0's ends at 5).
+    EXPECT_EQ(fs.in_first, (std::vector<index_t>{0, 0, 1, 2}));
+    EXPECT_EQ(fs.in_part, (std::vector<index_t>{0, 1}));
+    // A backward target, parts that do not cover the items: rejected.
+    EXPECT_THROW(make_forward_spill(3, std::vector<index_t>{0, 3}, [](index_t i) { return i == 2 ? index_t(1) : i; }),
+                 InvalidArgument);
+    EXPECT_THROW(make_forward_spill(3, std::vector<index_t>{0, 2}, [](index_t i) { return i; }), InvalidArgument);
+    EXPECT_THROW(make_forward_spill(3, std::vector<index_t>{0, 2, 1, 3}, [](index_t i) { return i; }), InvalidArgument);
+    // Balanced parts follow the weights: item 0 weighs as much as the rest.
+    EXPECT_EQ(balanced_parts(std::vector<index_t>{0, 6, 7, 8, 9, 10, 11, 12}, 2), (std::vector<index_t>{0, 1, 7}));
+    EXPECT_EQ(balanced_parts(std::vector<index_t>{0, 1, 2, 3, 4}, 4), (std::vector<index_t>{0, 1, 2, 3, 4}));
+}
+
 TEST(Colourings, ConflictFree) {
     for (const auto& nm : meshes()) {
         const auto models = edgefem::test::make_models<double>(nm.mesh);
@@ -201,6 +254,7 @@ TEST(Colourings, ConflictFree) {
         // Independent write sets, from the topology rather than the model.
         const Topology& topo = models.topo;
         const ResourceFn edge_w = test::edge_write_set(topo);
+        const ResourceFn seg_w = test::vertex_segment_write_set(topo);
         const ResourceFn tsep_w = test::tsep_strain_write_set(topo);
         const ResourceFn stiff_w = test::tsep_stiffness_write_set(topo);
         const ResourceFn tet_w = [&](index_t t, std::vector<index_t>& out) {
@@ -210,8 +264,9 @@ TEST(Colourings, ConflictFree) {
             ColouringOptions o;
             o.block = block;
             const Colouring ce = colour_edges(m, o), ct = colour_tsep_strain(m, o), cs = colour_tsep_stiffness(m, o),
-                            cq = colour_tets(models.tet, o);
+                            cq = colour_tets(models.tet, o), cv = colour_vertex_segments(m, o);
             EXPECT_EQ(colouring_conflicts(ce, m.num_vertices, edge_w), 0) << nm.name;
+            EXPECT_EQ(colouring_conflicts(cv, m.num_vertices, seg_w), 0) << nm.name;
             EXPECT_EQ(colouring_conflicts(ct, m.num_edges(), tsep_w), 0) << nm.name;
             EXPECT_EQ(colouring_conflicts(cs, m.num_edges(), stiff_w), 0) << nm.name;
             EXPECT_EQ(colouring_conflicts(cq, nm.mesh.num_vertices(), tet_w), 0) << nm.name;
@@ -232,6 +287,9 @@ TEST(Colourings, ConflictFree) {
         };
         const ParallelEdgeKernels<double> pk(m, std::make_shared<SerialExecutor>(), Variant::Colour, {}, form);
         EXPECT_EQ(colouring_conflicts(pk.form_colouring(), m.num_edges(), batch_w), 0) << nm.name;
+        // The default plan's vertex-segment colouring (blocks chosen per mesh).
+        EXPECT_EQ(colouring_conflicts(pk.vertex_colouring(), m.num_vertices, seg_w), 0) << nm.name;
+        if (m.num_vertices >= 64) EXPECT_GT(pk.vertex_colouring().colours(), 1) << nm.name;
         // The checker does catch a conflict.
         Colouring bad = colour_edges(m);
         if (m.num_edges() > 1) {

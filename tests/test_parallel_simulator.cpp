@@ -61,7 +61,7 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
     for (Method method : {Method::Edge, Method::Tet}) {
         const Result core = run(method, nullptr, {});
         EXPECT_GT(edgefem::test::max_abs(core.u), 0);
-        for (Variant var : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private}) {
+        for (Variant var : kAllVariants) {
             const auto serial_ex = std::make_shared<SerialExecutor>();
             const Result serial = run(method, serial_ex, parallel_operator_factory<double>(serial_ex, var));
             const std::string tag = std::string(method == Method::Edge ? "edge/" : "tet/") + to_string(var);

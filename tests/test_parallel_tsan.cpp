@@ -54,10 +54,12 @@ TEST(ParallelTsan, EdgeKernels) {
     const auto models = edgefem::test::make_models<double>(mesh);
     const auto u = deformation_displacement(mesh, Deformation::Twist);
     const auto x = deformation_displacement(mesh, Deformation::Random);
-    for (Variant v : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private}) {
+    for (Variant v : kAllVariants) {
         std::vector<double> ref_f, ref_y, ref_D, ref_K;
         for (int threads : {1, 3}) {
-            ParallelEdgeKernels<double> k(models.edge, std::make_shared<ThreadExecutor>(threads), v);
+            PlanOptions opts;
+            opts.owner_parts = 5;  // the owner variant's spill windows in use (every part spills)
+            ParallelEdgeKernels<double> k(models.edge, std::make_shared<ThreadExecutor>(threads), v, opts);
             std::vector<double> f(u.size()), y(u.size()), D(3 * u.size());
             EdgeState<double> st;
             EdgeStiffness<double> K;
@@ -80,7 +82,7 @@ TEST(ParallelTsan, EdgeKernels) {
 
 TEST(ParallelTsan, TetKernelsAndStep) {
     for (Method method : {Method::Edge, Method::Tet})
-        for (Variant v : {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private}) {
+        for (Variant v : kAllVariants) {
             Scene s;
             s.mesh = make_box(5, 2, 2);
             s.materials = Material{2e4, 0.3, 1000};

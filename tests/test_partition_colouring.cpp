@@ -115,7 +115,7 @@ Outputs run_parallel(const EdgeModel<double>& m, std::shared_ptr<const Executor>
 
 PlanOptions part_plan(const EdgeModel<double>& m, const std::vector<index_t>& part_first) {
     PlanOptions o;
-    o.edge_colouring = part_colouring(m, part_first, blocked_colouring());
+    o.vertex_colouring = part_vertex_colouring(part_first, blocked_vertex_colouring());
     o.segment_colouring = part_colouring(m, part_first, blocked_colouring());
     return o;
 }
@@ -203,12 +203,18 @@ TEST(PartitionColouring, ConflictFreeAndCoverEveryItemOnce) {
         const Topology& topo = models.topo;
         // Independent write sets, from the topology rather than the model.
         const ResourceFn edge_w = test::edge_write_set(topo);
+        const ResourceFn seg_w = test::vertex_segment_write_set(topo);
         const ResourceFn tsep_w = test::tsep_strain_write_set(topo);
         const ResourceFn stiff_w = test::tsep_stiffness_write_set(topo);
         for (bool balance : {true, false}) {
             ColouringOptions base;
             base.balance = balance;
             const ColouringOptions o = part_colouring(m, pm.part_first, base);
+            // The parts themselves as units of vertex segments.
+            const Colouring cv = colour_vertex_segments(m, part_vertex_colouring(pm.part_first, base));
+            EXPECT_EQ(colouring_conflicts(cv, m.num_vertices, seg_w), 0);
+            EXPECT_TRUE(covers_once(cv, m.num_vertices));
+            EXPECT_EQ(cv.num_units(), index_t(pm.part_first.size() - 1));
             const Colouring ce = colour_edges(m, o), ct = colour_tsep_strain(m, o), cs = colour_tsep_stiffness(m, o);
             EXPECT_EQ(colouring_conflicts(ce, m.num_vertices, edge_w), 0);
             EXPECT_EQ(colouring_conflicts(ct, m.num_edges(), tsep_w), 0);
@@ -322,7 +328,7 @@ TEST(PartitionColouring, ParallelOperatorTakesPartUnitsThroughPlanOptions) {
     }
     // Parts of another mesh do not fit: rejected when the plan is built.
     PlanOptions wrong = opts;
-    wrong.edge_colouring.unit_first.back() += 1;
+    wrong.vertex_colouring.unit_first.back() += 1;
     EXPECT_THROW(make_parallel_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge,
                                                 make_executor(Backend::OpenMP, 1), Variant::Colour, wrong),
                  InvalidArgument);

@@ -542,7 +542,7 @@ void add_bench_layouts_command(CLI::App& app) {
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
     cmd->add_option("--variant", opts->variant, "Parallel variant of omp/tbb rows (see `edgefem bench --help`)")
-        ->check(CLI::IsMember({"colour", "color", "gather", "atomic", "private"}))
+        ->check(CLI::IsMember({"colour", "color", "gather", "atomic", "private", "owner"}))
         ->capture_default_str();
     cmd->add_option("--precision", opts->precision, "Scalar type of the tet-local and tsep-list rows")
         ->check(CLI::IsMember({"double", "float"}))

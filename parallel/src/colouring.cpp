@@ -222,6 +222,14 @@ ResourceFn edge_scatter_resources(const EdgeModel<S>& m) {
 }
 
 template <class S>
+ResourceFn vertex_segment_resources(const EdgeModel<S>& m) {
+    return [&m](index_t a, std::vector<index_t>& out) {
+        out.push_back(a);
+        for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) out.push_back(m.edge[e][1]);
+    };
+}
+
+template <class S>
 ResourceFn tsep_strain_resources(const EdgeModel<S>& m) {
     return [&m](index_t e0, std::vector<index_t>& out) {
         out.push_back(e0);
@@ -267,6 +275,8 @@ std::vector<index_t> units_from_vertex_parts(std::span<const index_t> item_first
 
 template ResourceFn edge_scatter_resources(const EdgeModel<double>&);
 template ResourceFn edge_scatter_resources(const EdgeModel<float>&);
+template ResourceFn vertex_segment_resources(const EdgeModel<double>&);
+template ResourceFn vertex_segment_resources(const EdgeModel<float>&);
 template ResourceFn tsep_strain_resources(const EdgeModel<double>&);
 template ResourceFn tsep_strain_resources(const EdgeModel<float>&);
 template ResourceFn tsep_stiffness_resources(const EdgeModel<double>&);

@@ -1,5 +1,7 @@
 #include "edgefem/parallel/executors.hpp"
 
+#include <algorithm>
+
 #include <omp.h>
 
 #include <oneapi/tbb/blocked_range.h>
@@ -62,6 +64,31 @@ void OmpExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body
     }
 }
 
+void OmpExecutor::for_phases(const std::vector<index_t>& chunks,
+                             const std::function<void(int, index_t)>& body) const {
+    const int phases = int(chunks.size());
+    const index_t widest = phases > 0 ? *std::max_element(chunks.begin(), chunks.end()) : 0;
+    if (threads_ == 1 || widest <= 1) {
+        for (int p = 0; p < phases; ++p)
+            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+        return;
+    }
+    const int t = int(std::min<index_t>(threads_, widest));
+    if (schedule_ == Schedule::Static) {
+#pragma omp parallel num_threads(t)
+        for (int p = 0; p < phases; ++p) {
+#pragma omp for schedule(static)
+            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+        }
+    } else {
+#pragma omp parallel num_threads(t)
+        for (int p = 0; p < phases; ++p) {
+#pragma omp for schedule(dynamic, 1)
+            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+        }
+    }
+}
+
 // ---- TBB --------------------------------------------------------------------
 
 struct TbbExecutor::Impl {
@@ -96,6 +123,29 @@ void TbbExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body
             tbb::parallel_for(range, run, tbb::static_partitioner());
         else
             tbb::parallel_for(range, run, tbb::simple_partitioner());
+    });
+}
+
+void TbbExecutor::for_phases(const std::vector<index_t>& chunks,
+                             const std::function<void(int, index_t)>& body) const {
+    if (threads_ == 1) {
+        for (int p = 0; p < int(chunks.size()); ++p)
+            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+        return;
+    }
+    impl_->arena.execute([&] {
+        for (int p = 0; p < int(chunks.size()); ++p) {
+            const auto run = [&](const tbb::blocked_range<index_t>& r) {
+                for (index_t c = r.begin(); c < r.end(); ++c) body(p, c);
+            };
+            if (chunks[p] <= 1) {
+                if (chunks[p] == 1) body(p, 0);
+            } else if (schedule_ == Schedule::Static) {
+                tbb::parallel_for(tbb::blocked_range<index_t>(0, chunks[p], 1), run, tbb::static_partitioner());
+            } else {
+                tbb::parallel_for(tbb::blocked_range<index_t>(0, chunks[p], 1), run, tbb::simple_partitioner());
+            }
+        }
     });
 }
 

@@ -13,7 +13,9 @@ Variant parse_variant(std::string_view name) {
     if (name == "gather") return Variant::Gather;
     if (name == "atomic") return Variant::Atomic;
     if (name == "private") return Variant::Private;
-    throw InvalidArgument("unknown variant '" + std::string(name) + "' (expected colour, gather, atomic or private)");
+    if (name == "owner") return Variant::Owner;
+    throw InvalidArgument("unknown variant '" + std::string(name) +
+                          "' (expected colour, gather, atomic, private or owner)");
 }
 
 const char* to_string(Variant v) {
@@ -21,6 +23,7 @@ const char* to_string(Variant v) {
         case Variant::Colour: return "colour";
         case Variant::Gather: return "gather";
         case Variant::Atomic: return "atomic";
+        case Variant::Owner: return "owner";
         default: return "private";
     }
 }
@@ -175,7 +178,7 @@ ColouringReport colouring_report(const Mesh& mesh, const PlanOptions& opts) {
     const Materials mat(Material{});
     const EdgeModel<double> m = make_edge_model<double>(topo, compute_coefficients(mesh, topo, mat));
     ColouringReport r;
-    r.edges = colour_edges(m, opts.edge_colouring).stats();
+    r.edges = colour_vertex_segments(m, resolved_vertex_colouring(opts.vertex_colouring, m.num_vertices)).stats();
     r.tsep_strain = colour_tsep_strain(m, opts.segment_colouring).stats();
     r.tsep_stiffness = colour_tsep_stiffness(m, opts.segment_colouring).stats();
     r.tets = colour_tets(make_tet_model<double>(mesh, mat), opts.tet_colouring).stats();

@@ -16,6 +16,14 @@ inline ResourceFn edge_write_set(const Topology& topo) {
     };
 }
 
+// Vertex segment a (the edges whose V0 is a): a and their V1.
+inline ResourceFn vertex_segment_write_set(const Topology& topo) {
+    return [&topo](index_t a, std::vector<index_t>& out) {
+        out.push_back(a);
+        for (index_t e = topo.first_edge[a]; e < topo.first_edge[a + 1]; ++e) out.push_back(topo.edges[e][1]);
+    };
+}
+
 // TSEP strain segment e0: g(e0) and g(E1) of its TSEPs.
 inline ResourceFn tsep_strain_write_set(const Topology& topo) {
     return [&topo](index_t e0, std::vector<index_t>& out) {

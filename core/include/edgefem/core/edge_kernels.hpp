@@ -61,17 +61,25 @@ inline void edge_strain(const EdgeModel<S>& m, const S* __restrict u, index_t e,
 // TSEP loop worker for the segment of TSEPs whose first edge is e0: each
 // pair adds L(P) zeta(E1) to g(E0) and L(P) zeta(E0) to g(E1). The E1 of a
 // segment are distinct and greater than e0, so nothing inside it aliases.
-template <class S>
-inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g) {
+// `fwd(t)` locates the forward target g(E1) (E1 > e0): by default g + E1;
+// the owner-computes parallel variant sends targets past its part to a
+// spill buffer (the segment kernels below take the same argument).
+template <class S, class Fwd>
+inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g,
+                                Fwd&& fwd) {
     const double z0 = zeta[e0];
     double acc = 0;
     for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
         const index_t e1 = m.tsep_other[P];
         const double L = m.LP[P];
         acc += L * double(zeta[e1]);
-        g[e1] += L * z0;
+        *fwd(e1) += L * z0;
     }
     g[e0] += acc;
+}
+template <class S>
+inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g) {
+    tsep_strain_segment(m, e0, zeta, g, [g](index_t e1) { return g + e1; });
 }
 
 // Edge scatter worker: f(V0) += p~ g, f(V1) -= p~ g.
@@ -89,24 +97,29 @@ inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, 
 // Edge scatter over the segment of edges whose V0 is `a`: f(a) gets the
 // segment's sum from registers (edges are sorted by V0, so a per-edge
 // f(V0) += ... would chain stores to one address); each f(V1) -= p~ g.
-template <class S>
+template <class S, class Fwd>
 inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
-                               S* __restrict f) {
+                               S* __restrict f, Fwd&& fwd) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
     for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
-        const index_t b = m.edge[e][1];
+        S* fb = fwd(m.edge[e][1]);
         const S ge = S(g[e]);
         const S v0 = p[3 * std::size_t(e)] * ge, v1 = p[3 * std::size_t(e) + 1] * ge, v2 = p[3 * std::size_t(e) + 2] * ge;
         acc0 += v0;
         acc1 += v1;
         acc2 += v2;
-        f[3 * std::size_t(b)] -= v0;
-        f[3 * std::size_t(b) + 1] -= v1;
-        f[3 * std::size_t(b) + 2] -= v2;
+        fb[0] -= v0;
+        fb[1] -= v1;
+        fb[2] -= v2;
     }
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
     f[3 * std::size_t(a) + 2] += acc2;
+}
+template <class S>
+inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
+                               S* __restrict f) {
+    edge_force_segment(m, a, p, g, f, [f](index_t b) { return f + 3 * std::size_t(b); });
 }
 
 // The TSEP loop and the edge scatter fused, over the segment of edges whose
@@ -140,15 +153,15 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
         }
         const double ge = g[e] + s;
         g[e] = ge;
-        const index_t b = m.edge[e][1];
+        S* fb = f + 3 * std::size_t(m.edge[e][1]);
         const S gs = S(ge);
         const S v0 = p[3 * std::size_t(e)] * gs, v1 = p[3 * std::size_t(e) + 1] * gs, v2 = p[3 * std::size_t(e) + 2] * gs;
         acc0 += v0;
         acc1 += v1;
         acc2 += v2;
-        f[3 * std::size_t(b)] -= v0;
-        f[3 * std::size_t(b) + 1] -= v1;
-        f[3 * std::size_t(b) + 2] -= v2;
+        fb[0] -= v0;
+        fb[1] -= v1;
+        fb[2] -= v2;
     }
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
@@ -240,9 +253,9 @@ struct Xyz4 {
 // registers, as in edge_force_segment). Built-in scalars run it in 4-lane
 // vectors: K(E)^T d as three row-times-broadcast FMAs, K(E) d as lane-wise
 // products summed once per segment (half the scalar version's operations).
-template <class S>
+template <class S, class Fwd>
 inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
-                            S* __restrict y) {
+                            S* __restrict y, Fwd&& fwd) {
     if constexpr (std::is_floating_point_v<S>) {
         using X = Xyz4<S>;
         using V = typename X::V;
@@ -259,7 +272,8 @@ inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restric
             // y(V1) is summed into last: its chain through memory (the next
             // segment often updates the same vertex) stays one add long.
             const V t = d[0] * k0 + d[1] * k1 + d[2] * k2;
-            X::store(&y[b], X::load(&y[b]) + t);
+            S* yb = fwd(m.edge[e][1]);
+            X::store(yb, X::load(yb) + t);
         }
         S* ya = &y[3 * std::size_t(a)];
         ya[0] -= r0[0] + r0[1] + r0[2];
@@ -275,14 +289,20 @@ inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restric
             acc0 += k[0] * d0 + k[1] * d1 + k[2] * d2;
             acc1 += k[3] * d0 + k[4] * d1 + k[5] * d2;
             acc2 += k[6] * d0 + k[7] * d1 + k[8] * d2;
-            y[3 * std::size_t(b)] += k[0] * d0 + k[3] * d1 + k[6] * d2;
-            y[3 * std::size_t(b) + 1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
-            y[3 * std::size_t(b) + 2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
+            S* yb = fwd(b);
+            yb[0] += k[0] * d0 + k[3] * d1 + k[6] * d2;
+            yb[1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
+            yb[2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
         }
         y[3 * std::size_t(a)] -= acc0;
         y[3 * std::size_t(a) + 1] -= acc1;
         y[3 * std::size_t(a) + 2] -= acc2;
     }
+}
+template <class S>
+inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
+                            S* __restrict y) {
+    edge_kx_segment(m, a, K, x, y, [y](index_t b) { return y + 3 * std::size_t(b); });
 }
 
 // Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
@@ -295,6 +315,24 @@ inline void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict 
             D[9 * std::size_t(a) + 3 * i + j] -= k[3 * i + j];
             D[9 * std::size_t(b) + 3 * i + j] -= k[3 * j + i];
         }
+}
+
+// Diagonal blocks over the segment of edges whose V0 is `a` (D(V1) located
+// by fwd, as in the segment kernels above; same operations in the same
+// order as edge_diagonal over the segment's edges).
+template <class S, class Fwd>
+inline void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D,
+                                  Fwd&& fwd) {
+    S* da = &D[9 * std::size_t(a)];
+    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
+        const S* k = &K[9 * std::size_t(e)];
+        S* db = fwd(m.edge[e][1]);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                da[3 * i + j] -= k[3 * i + j];
+                db[3 * i + j] -= k[3 * j + i];
+            }
+    }
 }
 
 }  // namespace kernel

@@ -21,6 +21,15 @@ public:
     // Calls body(c) once for every c in [0, n), possibly concurrently, and
     // returns when all calls have finished.
     virtual void for_chunks(index_t n, const std::function<void(index_t)>& body) const = 0;
+    // Phases one after another (the colours of a coloured scatter): in phase
+    // p, body(p, c) for every c in [0, chunks[p]), possibly concurrently.
+    // Same calls as one for_chunks per phase, which is the default; an
+    // executor may run all phases in one parallel region with a barrier
+    // between them (a barrier costs less than starting a region).
+    virtual void for_phases(const std::vector<index_t>& chunks,
+                            const std::function<void(int, index_t)>& body) const {
+        for (int p = 0; p < int(chunks.size()); ++p) for_chunks(chunks[p], [&](index_t c) { body(p, c); });
+    }
 };
 
 class SerialExecutor final : public Executor {

@@ -102,6 +102,10 @@ long colouring_conflicts(const Colouring& c, index_t num_resources, const Resour
 // Edge scatter (forces, K x, diagonal blocks): V0(E), V1(E).
 template <class S>
 ResourceFn edge_scatter_resources(const EdgeModel<S>& m);
+// Vertex segment a (the edges whose V0 is a, as the segment kernels
+// edge_force_segment / edge_kx_segment run them): a and every V1(E).
+template <class S>
+ResourceFn vertex_segment_resources(const EdgeModel<S>& m);
 // TSEP strain segment e0: g(e0) and g(E1) for its TSEPs.
 template <class S>
 ResourceFn tsep_strain_resources(const EdgeModel<S>& m);
@@ -116,6 +120,10 @@ ResourceFn tet_scatter_resources(const TetModel<S>& m);
 template <class S>
 Colouring colour_edges(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
     return colour_items(m.num_edges(), m.num_vertices, edge_scatter_resources(m), opts);
+}
+template <class S>
+Colouring colour_vertex_segments(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
+    return colour_items(m.num_vertices, m.num_vertices, vertex_segment_resources(m), opts);
 }
 template <class S>
 Colouring colour_tsep_strain(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
@@ -140,15 +148,21 @@ Colouring colour_tets(const TetModel<S>& m, const ColouringOptions& opts = {}) {
 // item are dropped (no empty units).
 std::vector<index_t> units_from_vertex_parts(std::span<const index_t> item_first, std::span<const index_t> part_first);
 
-// ColouringOptions whose units are the parts' edge ranges, for the edge
-// scatter (forces, K x, diagonal blocks: PlanOptions::edge_colouring) and,
-// since TSEP segment e0 is the TSEPs of edge e0, for the TSEP segments
-// (PlanOptions::segment_colouring) as well. `base` supplies the other
-// settings (balancing, chunking); its block is ignored.
+// ColouringOptions whose units are the parts' edge ranges, for the TSEP
+// segments (PlanOptions::segment_colouring: TSEP segment e0 is the TSEPs of
+// edge e0). `base` supplies the other settings (balancing, chunking); its
+// block is ignored.
 template <class S>
 ColouringOptions part_colouring(const EdgeModel<S>& m, std::span<const index_t> part_first,
                                 ColouringOptions base = {}) {
     base.unit_first = units_from_vertex_parts(m.edge_first, part_first);
+    return base;
+}
+// ColouringOptions whose units are the parts themselves (vertex ranges), for
+// the vertex segments of the edge scatter (forces, K x, diagonal blocks:
+// PlanOptions::vertex_colouring).
+inline ColouringOptions part_vertex_colouring(std::span<const index_t> part_first, ColouringOptions base = {}) {
+    base.unit_first.assign(part_first.begin(), part_first.end());
     return base;
 }
 

@@ -34,6 +34,9 @@ public:
     const char* name() const override { return "omp"; }
     Schedule schedule() const { return schedule_; }
     void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
+    // One parallel region for all phases, `omp for` (with its barrier) per phase.
+    void for_phases(const std::vector<index_t>& chunks,
+                    const std::function<void(int, index_t)>& body) const override;
 
 private:
     int threads_;
@@ -52,6 +55,9 @@ public:
     const char* name() const override { return "tbb"; }
     Schedule schedule() const { return schedule_; }
     void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
+    // All phases inside one arena entry, one parallel_for per phase.
+    void for_phases(const std::vector<index_t>& chunks,
+                    const std::function<void(int, index_t)>& body) const override;
 
 private:
     struct Impl;

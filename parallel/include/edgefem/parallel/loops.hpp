@@ -31,18 +31,18 @@ inline index_t range_chunk(index_t n, index_t max_chunk) {
 // the chunks run concurrently (chunk_id is global, see Colouring).
 template <class Body>
 void for_colours(const Executor& ex, const Colouring& col, Body&& body) {
-    for (int c = 0; c < col.colours(); ++c) {
+    std::vector<index_t> chunks(col.colours());
+    for (int c = 0; c < col.colours(); ++c) chunks[c] = col.chunk_first[c + 1] - col.chunk_first[c];
+    ex.for_phases(chunks, [&](int c, index_t k) {
         const index_t ub = col.colour_first[c], ue = col.colour_first[c + 1];
-        const index_t cu = col.chunk_units[c], first_chunk = col.chunk_first[c];
-        ex.for_chunks(col.chunk_first[c + 1] - first_chunk, [&](index_t k) {
-            const index_t end = std::min(ue, ub + (k + 1) * cu);
-            for (index_t x = ub + k * cu; x < end; ++x) {
-                const index_t u = col.units[x];
-                const index_t ie = col.unit_end(u);
-                for (index_t i = col.unit_begin(u); i < ie; ++i) body(i, first_chunk + k);
-            }
-        });
-    }
+        const index_t cu = col.chunk_units[c];
+        const index_t end = std::min(ue, ub + (k + 1) * cu);
+        for (index_t x = ub + k * cu; x < end; ++x) {
+            const index_t u = col.units[x];
+            const index_t ie = col.unit_end(u);
+            for (index_t i = col.unit_begin(u); i < ie; ++i) body(i, col.chunk_first[c] + k);
+        }
+    });
 }
 
 // The private-accumulator split: `parts` contiguous pieces of [0, n).

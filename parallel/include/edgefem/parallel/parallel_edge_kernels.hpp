@@ -1,7 +1,11 @@
 // The edge-based kernels of core (edge_kernels.hpp) run on an Executor.
 // Every formula is core's: the coloured and private variants run the plain
-// workers (kernel::edge_strain, tsep_strain_segment, edge_force,
-// edge_stiffness, tsep_stiffness_segment, edge_kx, edge_diagonal), the
+// workers (kernel::edge_strain, tsep_strain_segment, edge_stiffness,
+// tsep_stiffness_segment; the coloured edge scatter runs the vertex-segment
+// workers edge_force_segment, edge_kx_segment and edge_diagonal over
+// coloured blocks of vertices, the private one edge_force, edge_kx; the
+// owner variant runs the segment workers over fixed parts, forward targets
+// past a part going to its spill window, see forward_spill.hpp), the
 // gather and atomic variants the worker variants of
 // core/edge_kernel_variants.hpp. This class only decides which items run
 // where, and owns the per-mesh plan (colourings, gather lists, private
@@ -23,6 +27,7 @@
 #include "edgefem/core/executor.hpp"
 #include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/parallel/colouring.hpp"
+#include "edgefem/parallel/forward_spill.hpp"
 #include "edgefem/parallel/loops.hpp"
 #include "edgefem/parallel/variant.hpp"
 
@@ -54,9 +59,15 @@ public:
     void diagonal_blocks(const EdgeStiffness<S>& K, S* D) const;
 
     // Colour variant only (empty otherwise).
-    const Colouring& edge_colouring() const { return edge_col_; }
+    // The edge scatter's colouring: units of vertices, each running its
+    // segment (the edges whose V0 it is).
+    const Colouring& vertex_colouring() const { return vert_col_; }
     const Colouring& tsep_colouring() const { return tsep_col_; }
     const Colouring& stiffness_colouring() const { return stiff_col_; }
+    // Owner variant only: the parts of the edge scatter (vertices) and of
+    // the TSEP loop (edges), with their spill windows.
+    const ForwardSpill& vertex_parts() const { return vspill_; }
+    const ForwardSpill& edge_parts() const { return espill_; }
     // Tet-local stiffness only: the colouring of the form's batches.
     const Colouring& form_colouring() const { return form_col_; }
     bool tet_local_stiffness() const { return form_.num_tets > 0; }
@@ -84,6 +95,9 @@ private:
         if (buf.size() != len * std::size_t(parts_)) buf.assign(len * std::size_t(parts_), T(0));
         return buf;
     }
+    // Incoming stiffness contributions per edge (the one-pass TSEP-list
+    // stiffness of the gather and owner variants).
+    void build_stiffness_sources();
 
     EdgeModel<S> m_;
     std::shared_ptr<const Executor> ex_;
@@ -91,7 +105,7 @@ private:
     index_t range_chunk_;
     int parts_ = 1;          // private accumulators
     index_t num_sinks_ = 1;  // sink blocks after the #E edge blocks
-    Colouring edge_col_, tsep_col_, stiff_col_;
+    Colouring vert_col_, tsep_col_, stiff_col_;
     TetEdgeForm<S> form_;  // empty: TSEP-list stiffness
     Colouring form_col_;
     // Gather lists: vertex -> incident edges (side-encoded), edge -> incoming
@@ -101,6 +115,11 @@ private:
     std::vector<S> tin_L_;
     std::vector<index_t> kin_first_;
     std::vector<kernel::StiffnessSource> kin_;
+    // Owner variant: parts and spill windows (values per target: 3 for
+    // forces and K x, 9 for diagonal blocks, 1 for g), kept zeroed.
+    ForwardSpill vspill_, espill_;
+    mutable std::vector<S> spill_v_, spill_d_;
+    mutable std::vector<double> spill_g_;
     // Private accumulators (allocated on first use).
     mutable std::vector<S> pv_, pd_, pk_;
     mutable std::vector<double> pg_;
@@ -136,7 +155,7 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
     }
     switch (variant_) {
         case Variant::Colour: {
-            edge_col_ = colour_edges(m_, opts.edge_colouring);
+            vert_col_ = colour_vertex_segments(m_, resolved_vertex_colouring(opts.vertex_colouring, nv));
             tsep_col_ = colour_tsep_strain(m_, opts.segment_colouring);
             if (opts.stiffness && !m_.target.empty()) {
                 stiff_col_ = colour_tsep_stiffness(m_, opts.segment_colouring);
@@ -183,22 +202,26 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
                     tin_e0_[at] = e0;
                     tin_L_[at] = m_.LP[P];
                 }
-            if (opts.stiffness && !m_.target.empty()) {
-                kin_first_.assign(std::size_t(ne) + 1, 0);
-                for (index_t P = 0; P < np; ++P)
-                    for (int k = 0; k < 4; ++k)
-                        if ((m_.target[P][k] >> 1) < ne) ++kin_first_[(m_.target[P][k] >> 1) + 1];
-                for (index_t e = 0; e < ne; ++e) kin_first_[e + 1] += kin_first_[e];
-                kin_.resize(kin_first_.back());
-                pos.assign(kin_first_.begin(), kin_first_.end() - 1);
-                for (index_t e0 = 0; e0 < ne; ++e0)  // ascending (P, k) per target
-                    for (index_t P = m_.tsep_first[e0]; P < m_.tsep_first[e0 + 1]; ++P)
-                        for (int k = 0; k < 4; ++k) {
-                            const index_t t = m_.target[P][k];
-                            if ((t >> 1) >= ne) continue;
-                            kin_[pos[t >> 1]++] = {P, e0, std::uint8_t(k | ((t & 1) << 2))};
-                        }
-            }
+            if (opts.stiffness && !m_.target.empty()) build_stiffness_sources();
+            break;
+        }
+        case Variant::Owner: {
+            const index_t P = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv);
+            const auto& m = m_;
+            vspill_ = make_forward_spill(nv, balanced_parts(m.edge_first, P), [&m](index_t a) {
+                index_t t = a;
+                for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) t = std::max(t, m.edge[e][1]);
+                return t;
+            });
+            espill_ = make_forward_spill(ne, balanced_parts(m.tsep_first, P), [&m](index_t e0) {
+                index_t t = e0;
+                for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) t = std::max(t, m.tsep_other[P]);
+                return t;
+            });
+            spill_v_.assign(3 * vspill_.spill_targets(), S(0));
+            spill_d_.assign(9 * vspill_.spill_targets(), S(0));
+            spill_g_.assign(espill_.spill_targets(), 0.0);
+            if (opts.stiffness && !m_.target.empty()) build_stiffness_sources();
             break;
         }
         default: break;
@@ -206,14 +229,37 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
 }
 
 template <class S>
+void ParallelEdgeKernels<S>::build_stiffness_sources() {
+    const index_t ne = m_.num_edges(), np = m_.num_tseps();
+    kin_first_.assign(std::size_t(ne) + 1, 0);
+    for (index_t P = 0; P < np; ++P)
+        for (int k = 0; k < 4; ++k)
+            if ((m_.target[P][k] >> 1) < ne) ++kin_first_[(m_.target[P][k] >> 1) + 1];
+    for (index_t e = 0; e < ne; ++e) kin_first_[e + 1] += kin_first_[e];
+    kin_.resize(kin_first_.back());
+    std::vector<index_t> pos(kin_first_.begin(), kin_first_.end() - 1);
+    for (index_t e0 = 0; e0 < ne; ++e0)  // ascending (P, k) per target
+        for (index_t P = m_.tsep_first[e0]; P < m_.tsep_first[e0 + 1]; ++P)
+            for (int k = 0; k < 4; ++k) {
+                const index_t t = m_.target[P][k];
+                if ((t >> 1) >= ne) continue;
+                kin_[pos[t >> 1]++] = {P, e0, std::uint8_t(k | ((t & 1) << 2))};
+            }
+}
+
+template <class S>
 std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
     auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
     std::size_t b = 0;
-    for (const Colouring* c : {&edge_col_, &tsep_col_, &stiff_col_, &form_col_})
+    for (const Colouring* c : {&vert_col_, &tsep_col_, &stiff_col_, &form_col_})
         b += bytes(c->units) + bytes(c->colour_first) + bytes(c->chunk_first) + bytes(c->chunk_units);
     b += bytes(inc_first_) + bytes(inc_) + bytes(tin_first_) + bytes(tin_e0_) + bytes(tin_L_) + bytes(kin_first_) +
          bytes(kin_);
     b += bytes(pv_) + bytes(pd_) + bytes(pk_) + bytes(pg_);
+    for (const ForwardSpill* fs : {&vspill_, &espill_})
+        b += bytes(fs->part_first) + bytes(fs->window_end) + bytes(fs->window_first) + bytes(fs->in_first) +
+             bytes(fs->in_part);
+    b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_);
     return b;
 }
 
@@ -265,6 +311,11 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
                         kernel::tsep_strain_segment_to(m, i, zeta, [g](std::size_t k, double v) { par::atomic_add(g, k, v); });
                 });
                 break;
+            case Variant::Owner:
+                run_forward_spill<1>(*ex_, espill_, g, spill_g_, [&](index_t, index_t b, index_t e, auto fwd) {
+                    for (index_t i = b; i < e; ++i) kernel::tsep_strain_segment(m, i, zeta, g, fwd);
+                });
+                break;
             case Variant::Private: {
                 auto& buf = private_buffer(pg_, ne);
                 each_part(ne, [&](int part, index_t b, index_t e) {
@@ -279,7 +330,7 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
     switch (variant_) {
         case Variant::Colour:
             each_range(index_t(nf), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
-            par::for_colours(*ex_, edge_col_, [&](index_t e, index_t) { kernel::edge_force(m, e, p, g, f); });
+            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { kernel::edge_force_segment(m, a, p, g, f); });
             break;
         case Variant::Gather:
             each_range(nv, [&](index_t b, index_t e) {
@@ -303,6 +354,14 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
             reduce_parts(buf, nf, nf, f, false);
             break;
         }
+        case Variant::Owner:
+            // A part's own range is written by no other part before the
+            // barrier, so it is zeroed inside the part's work.
+            run_forward_spill<3>(*ex_, vspill_, f, spill_v_, [&](index_t, index_t b, index_t e, auto fwd) {
+                std::fill(f + 3 * std::size_t(b), f + 3 * std::size_t(e), S(0));
+                for (index_t a = b; a < e; ++a) kernel::edge_force_segment(m, a, p, g, f, fwd);
+            });
+            break;
     }
     if constexpr (Energy)
         return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
@@ -318,7 +377,8 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
     const double* g = st.g.data();
     S* K = Ks.K.data();
     const auto& m = m_;
-    if (Kind == ModelKind::FE && !tet_local_stiffness() && variant_ == Variant::Gather) {  // one pass: K(E) = edge term + its TSEP terms
+    if (Kind == ModelKind::FE && !tet_local_stiffness() &&
+        (variant_ == Variant::Gather || variant_ == Variant::Owner)) {  // one pass: K(E) = edge term + its TSEP terms
         each_range(ne, [&](index_t b, index_t e) {
             for (index_t i = b; i < e; ++i) {
                 kernel::edge_stiffness<Definite>(m, i, p, g, K);
@@ -370,7 +430,7 @@ void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S*
     switch (variant_) {
         case Variant::Colour:
             each_range(index_t(ny), [&](index_t b, index_t e) { std::fill(y + b, y + e, S(0)); });
-            par::for_colours(*ex_, edge_col_, [&](index_t e, index_t) { kernel::edge_kx(m, e, K, x, y); });
+            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { kernel::edge_kx_segment(m, a, K, x, y); });
             break;
         case Variant::Gather:
             each_range(nv, [&](index_t b, index_t e) {
@@ -394,6 +454,12 @@ void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S*
             reduce_parts(buf, ny, ny, y, false);
             break;
         }
+        case Variant::Owner:
+            run_forward_spill<3>(*ex_, vspill_, y, spill_v_, [&](index_t, index_t b, index_t e, auto fwd) {
+                std::fill(y + 3 * std::size_t(b), y + 3 * std::size_t(e), S(0));
+                for (index_t a = b; a < e; ++a) kernel::edge_kx_segment(m, a, K, x, y, fwd);
+            });
+            break;
     }
 }
 
@@ -406,7 +472,9 @@ void ParallelEdgeKernels<S>::diagonal_blocks(const EdgeStiffness<S>& Ks, S* D) c
     switch (variant_) {
         case Variant::Colour:
             each_range(index_t(nd), [&](index_t b, index_t e) { std::fill(D + b, D + e, S(0)); });
-            par::for_colours(*ex_, edge_col_, [&](index_t e, index_t) { kernel::edge_diagonal(m, e, K, D); });
+            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) {
+                for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) kernel::edge_diagonal(m, e, K, D);
+            });
             break;
         case Variant::Gather:
             each_range(nv, [&](index_t b, index_t e) {
@@ -430,6 +498,12 @@ void ParallelEdgeKernels<S>::diagonal_blocks(const EdgeStiffness<S>& Ks, S* D) c
             reduce_parts(buf, nd, nd, D, false);
             break;
         }
+        case Variant::Owner:
+            run_forward_spill<9>(*ex_, vspill_, D, spill_d_, [&](index_t, index_t b, index_t e, auto fwd) {
+                std::fill(D + 9 * std::size_t(b), D + 9 * std::size_t(e), S(0));
+                for (index_t a = b; a < e; ++a) kernel::edge_diagonal_segment(m, a, K, D, fwd);
+            });
+            break;
     }
 }
 

@@ -1,6 +1,8 @@
 // How a parallel kernel resolves concurrent writes to one target.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <string_view>
 
 #include "edgefem/core/elastic_operator.hpp"
@@ -13,13 +15,16 @@ enum class Variant {
     Gather,   // pull: each target sums its sources via CSR lists (deterministic)
     Atomic,   // scatter with std::atomic_ref fetch_add (order varies run to run)
     Private,  // one accumulator per thread part, then a parallel blocked reduction
+    Owner,    // owner computes: fixed parts of consecutive items, forward spill + ordered reduction (deterministic)
 };
+inline constexpr Variant kAllVariants[] = {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private,
+                                           Variant::Owner};
 
-// "colour" (or "color") | "gather" | "atomic" | "private"; throws InvalidArgument.
+// "colour" (or "color") | "gather" | "atomic" | "private" | "owner"; throws InvalidArgument.
 Variant parse_variant(std::string_view name);
 const char* to_string(Variant v);
 // True for the variants whose results are bitwise independent of the thread count.
-inline bool is_deterministic(Variant v) { return v == Variant::Colour || v == Variant::Gather; }
+inline bool is_deterministic(Variant v) { return v == Variant::Colour || v == Variant::Gather || v == Variant::Owner; }
 
 // Blocks of consecutive items coloured as units: with a locality ordering a
 // block is spatially compact, so each thread streams through contiguous
@@ -33,6 +38,33 @@ inline ColouringOptions blocked_colouring() {
     return o;
 }
 
+// Vertex segments (the edges sharing their V0, run by the segment kernels
+// with V0's sum in registers) in blocks of consecutive vertices. block 0:
+// chosen per mesh by the kernels, about #V / 64 vertices (8..128, a function
+// of the mesh only), so small meshes still split into enough units.
+inline ColouringOptions blocked_vertex_colouring() {
+    ColouringOptions o;
+    o.block = 0;
+    o.max_chunk_items = 512;
+    return o;
+}
+
+// The owner variant's default part count: a function of the mesh only (so
+// results do not depend on the thread count), cbrt(#V) / 2.5 in 1..64. A
+// part's spill window spans about the ordering's bandwidth, ~#V^(2/3) for a
+// 3D mesh in RCM order, so this keeps the windows near 40 % of a part
+// (measured with RCM: 4 parts on bunny-4k, 40 %; 64 parts on bunny-250k,
+// 180 %, phase 2 then cost as much as phase 1).
+inline index_t default_owner_parts(index_t num_vertices) {
+    return std::clamp<index_t>(index_t(std::lround(std::cbrt(double(num_vertices)) / 2.5)), 1, 64);
+}
+
+// `o` with block 0 replaced by the per-mesh choice for `num_vertices`.
+inline ColouringOptions resolved_vertex_colouring(ColouringOptions o, index_t num_vertices) {
+    if (o.unit_first.empty() && o.block <= 0) o.block = std::clamp<index_t>(num_vertices / 8, 8, 128);
+    return o;
+}
+
 inline ColouringOptions form_batch_colouring() {
     ColouringOptions o;
     o.block = 8;
@@ -42,7 +74,7 @@ inline ColouringOptions form_batch_colouring() {
 }
 
 struct PlanOptions {
-    ColouringOptions edge_colouring = blocked_colouring();     // edge scatter (forces, K x, diagonal)
+    ColouringOptions vertex_colouring = blocked_vertex_colouring();  // edge scatter by vertex segment (forces, K x, diagonal)
     ColouringOptions segment_colouring = blocked_colouring();  // TSEP segments (g, K)
     ColouringOptions tet_colouring;      // per-tet scatter
     // FE stiffness from the tet-local form (default) or the TSEP list, and
@@ -50,6 +82,10 @@ struct PlanOptions {
     StiffnessLayout stiffness_layout = StiffnessLayout::TetLocal;
     ColouringOptions form_colouring = form_batch_colouring();
     index_t range_chunk = 2048;          // items per chunk of the uncoloured loops
+    // Owner variant: the number of parts (consecutive vertices for the edge
+    // scatter, consecutive edges for the TSEP loop, each balanced on the
+    // loop's work). 0: default_owner_parts(#V).
+    index_t owner_parts = 0;
     bool stiffness = true;               // build what the stiffness kernels need
 };
 
