@@ -9,6 +9,10 @@
 // ordering the blocked colourings and the owner variant's parts rely on
 // (with the input numbering of the shared meshes the owner variant's spill
 // windows cover 1.6-37x the vertices); all rows see the same numbering.
+// The stiffness is the default tet-local layout (core/tet_edge_form.hpp) in
+// core's serial loop and in every variant (its pair terms are a coloured
+// scatter over tet batches whatever the variant; the variant decides the
+// per-edge terms only).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -36,6 +40,7 @@ const char* name_of(Kernel k) { return k == Kernel::Force ? "force" : k == Kerne
 struct Prepared {
     std::string name;
     EdgeModel<double> model;
+    TetEdgeForm<double> form;
     std::vector<double> u, x;
 };
 
@@ -48,7 +53,9 @@ Prepared& prepared(const std::string& name) {
         const Topology topo = build_topology(mesh);
         p = std::make_unique<Prepared>();
         p->name = name;
-        p->model = make_edge_model<double>(topo, compute_coefficients(mesh, topo, Material{1e5, 0.3, 1000}));
+        const Materials mat(Material{1e5, 0.3, 1000});
+        p->model = make_edge_model<double>(topo, compute_coefficients(mesh, topo, mat));
+        p->form = make_tet_edge_form<double>(mesh, topo, mat);
         p->u = deformation_displacement(mesh, Deformation::Twist);
         p->x.resize(p->u.size());
         for (std::size_t i = 0; i < p->x.size(); ++i) p->x[i] = std::sin(0.7 * double(i));
@@ -82,7 +89,8 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant
     if (cur.key != key) {
         cur.k.reset();
         const auto t0 = std::chrono::steady_clock::now();
-        cur.k = std::make_unique<ParallelEdgeKernels<double>>(prepared(mesh).model, make_executor(b, threads), v);
+        cur.k = std::make_unique<ParallelEdgeKernels<double>>(prepared(mesh).model, make_executor(b, threads), v,
+                                                              PlanOptions{}, prepared(mesh).form);
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (v == Variant::Colour && b == Backend::OpenMP && threads == 1)
             std::fprintf(stderr, "%s colourings (plan %.2f s): vertex segments %s; tsep g %s; tsep K %s\n", mesh.c_str(), s,
@@ -116,11 +124,11 @@ void BM_Core(benchmark::State& state, std::string mesh, Kernel k) {
     EdgeState<double> st;
     EdgeStiffness<double> K;
     edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st);
-    edge_stiffness_all<ModelKind::FE>(p.model, st, K);
+    tet_form_stiffness_all<ModelKind::FE>(p.model, p.form, st, K);
     for (auto _ : state) {
         switch (k) {
             case Kernel::Force: edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st); break;
-            case Kernel::Stiffness: edge_stiffness_all<ModelKind::FE>(p.model, st, K); break;
+            case Kernel::Stiffness: tet_form_stiffness_all<ModelKind::FE>(p.model, p.form, st, K); break;
             case Kernel::Kx: edge_multiply(p.model, K, p.x.data(), y.data()); break;
         }
         benchmark::DoNotOptimize(f.data());
