@@ -10,7 +10,7 @@
 //
 //   edgefem_haptic_loop [--mesh PATH|box:NXxNYxNZ] [--seconds S] [--rate HZ]
 //       [--cg-iters N] [--stiffness-interval N] [--precision double|float] [--model fe|sn]
-//       [--backend serial|omp|tbb] [--threads N] [--force NEWTONS]
+//       [--backend serial|omp|tbb] [--threads N] [--variant V] [--force NEWTONS]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -31,6 +31,10 @@
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/async_tangent.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
+#endif
+#ifdef EDGEFEM_HAPTIC_HAVE_PARTITION
+#include "edgefem/partition/ordering.hpp"
+#include "edgefem/partition/permute_mesh.hpp"
 #endif
 
 #ifndef EDGEFEM_SHARED_MESHES
@@ -53,6 +57,8 @@ struct Options {
     bool async_tangent = false;  // build K on a background thread, swap it in when ready
     std::string backend = "serial";
     int threads = 0;
+    std::string variant = "gather";
+    std::string ordering = "rcm";
     double force = 0.2;  // N, spread over the probed vertices
     int probe_vertices = 6;
     double young = 1e6, poisson = 0.4, density = 1000;
@@ -66,7 +72,7 @@ struct Options {
     std::fprintf(stderr,
                  "edgefem_haptic_loop: %s\nusage: edgefem_haptic_loop [--mesh PATH|box:NXxNYxNZ] [--seconds S] "
                  "[--rate HZ] [--cg-iters N] [--stiffness-interval N] [--async-tangent] [--precision double|float] [--model fe|sn] "
-                 "[--backend serial|omp|tbb] [--threads N] [--force N] [--young PA] [--alpha 1/S] [--indefinite] [--free-run] [--gravity G]\n",
+                 "[--backend serial|omp|tbb] [--threads N] [--variant colour|gather|atomic|private|owner] [--ordering input|rcm] [--force N] [--young PA] [--alpha 1/S] [--indefinite] [--free-run] [--gravity G]\n",
                  msg);
     std::exit(2);
 }
@@ -89,6 +95,8 @@ Options parse(int argc, char** argv) {
         else if (a == "--async-tangent") o.async_tangent = true;
         else if (a == "--backend") o.backend = next();
         else if (a == "--threads") o.threads = std::atoi(next().c_str());
+        else if (a == "--variant") o.variant = next();
+        else if (a == "--ordering") o.ordering = next();
         else if (a == "--force") o.force = std::atof(next().c_str());
         else if (a == "--young") o.young = std::atof(next().c_str());
         else if (a == "--alpha") o.alpha = std::atof(next().c_str());
@@ -131,6 +139,16 @@ Mesh load(const Options& o, std::string& origin, int& up) {
         up = 1;
     }
     validate_mesh(mesh);
+    // Renumbered for memory locality (reverse Cuthill-McKee; the owner
+    // variant's parts rely on it). The loop reports statistics only, so the
+    // internal numbering never shows.
+    if (o.ordering == "rcm") {
+#ifdef EDGEFEM_HAPTIC_HAVE_PARTITION
+        mesh = permute_mesh(mesh, vertex_ordering(mesh, Ordering::RCM));
+#endif
+    } else if (o.ordering != "input") {
+        usage("--ordering: input or rcm");
+    }
     return mesh;
 }
 
@@ -208,7 +226,7 @@ int run(const Options& o) {
 #ifdef EDGEFEM_HAPTIC_HAVE_PARALLEL
     if (o.backend != "serial") {
         executor = make_executor(parse_backend(o.backend), o.threads);
-        factory = parallel_operator_factory<S>(executor);
+        factory = parallel_operator_factory<S>(executor, parse_variant(o.variant));
         backend = executor->name();
         threads = executor->threads();
     }
@@ -224,8 +242,9 @@ int run(const Options& o) {
 
     std::printf("mesh: %s\nvertices: %d\ntets: %d\nfixed_vertices: %zu\nsurface_vertices: %zu\n", origin.c_str(),
                 nv, sim.scene().mesh.num_tets(), sim.scene().fixed.size(), surface.size());
-    std::printf("integrator: semi-implicit\nmodel: %s\nprecision: %s\nbackend: %s\nthreads: %d\n", o.model.c_str(),
-                o.precision.c_str(), backend.c_str(), threads);
+    std::printf("integrator: semi-implicit\nmodel: %s\nprecision: %s\nbackend: %s\nthreads: %d\nvariant: %s\nordering: %s\n",
+                o.model.c_str(), o.precision.c_str(), backend.c_str(), threads,
+                o.backend == "serial" ? "-" : o.variant.c_str(), o.ordering.c_str());
     std::printf("young_pa: %g\nrayleigh_alpha: %g\ndefinite_stiffness: %s\n", o.young, o.alpha,
                 o.definite ? "true" : "false");
     std::printf("stiffness_interval: %d\nasync_tangent: %s\n", o.stiffness_interval, o.async_tangent ? "true" : "false");
