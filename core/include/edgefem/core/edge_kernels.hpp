@@ -9,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -58,28 +59,54 @@ inline void edge_strain(const EdgeModel<S>& m, const S* __restrict u, index_t e,
     g[e] = m.LE[e] * z;
 }
 
+// Where the segment kernels below write their forward targets (E1 > e0 of
+// a TSEP segment, V1 > a of a vertex segment): targets below `end` in
+// `direct` (indexed by target), the others in `spill` (indexed by target -
+// end). A segment's targets ascend, so it runs as two loops, the second
+// empty unless the segment reaches past `end`: the part boundary of the
+// owner-computes parallel variant (forward_spill.hpp); the serial loops
+// pass direct_only(out), which never spills.
+template <class T>
+struct ForwardOut {
+    T* direct;
+    T* spill;
+    index_t end;
+};
+template <class T>
+inline ForwardOut<T> direct_only(T* out) {
+    return {out, nullptr, std::numeric_limits<index_t>::max()};
+}
+// body(i, row of target(i)) for i in [first, last), W values per target.
+template <int W, class T, class Target, class Body>
+inline void for_segment(index_t first, index_t last, Target&& target, const ForwardOut<T>& out, Body&& body) {
+    index_t i = first;
+    for (; i < last; ++i) {
+        const index_t t = target(i);
+        if (t >= out.end) break;
+        body(i, out.direct + W * std::size_t(t));
+    }
+    for (; i < last; ++i) body(i, out.spill + W * std::size_t(target(i) - out.end));
+}
+
 // TSEP loop worker for the segment of TSEPs whose first edge is e0: each
 // pair adds L(P) zeta(E1) to g(E0) and L(P) zeta(E0) to g(E1). The E1 of a
 // segment are distinct and greater than e0, so nothing inside it aliases.
-// `fwd(t)` locates the forward target g(E1) (E1 > e0): by default g + E1;
-// the owner-computes parallel variant sends targets past its part to a
-// spill buffer (the segment kernels below take the same argument).
-template <class S, class Fwd>
+template <class S>
 inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g,
-                                Fwd&& fwd) {
+                                const ForwardOut<double>& out) {
     const double z0 = zeta[e0];
     double acc = 0;
-    for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
-        const index_t e1 = m.tsep_other[P];
-        const double L = m.LP[P];
-        acc += L * double(zeta[e1]);
-        *fwd(e1) += L * z0;
-    }
+    for_segment<1>(m.tsep_first[e0], m.tsep_first[e0 + 1], [&m](index_t P) { return m.tsep_other[P]; }, out,
+                   [&](index_t P, double* g1) {
+                       const double L = m.LP[P];
+                       acc += L * double(zeta[m.tsep_other[P]]);
+                       *g1 += L * z0;
+                   });
     g[e0] += acc;
 }
 template <class S>
 inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g) {
-    tsep_strain_segment(m, e0, zeta, g, [g](index_t e1) { return g + e1; });
+    tsep_strain_segment(m, e0, zeta, g, direct_only(g));
 }
 
 // Edge scatter worker: f(V0) += p~ g, f(V1) -= p~ g.
@@ -97,21 +124,22 @@ inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, 
 // Edge scatter over the segment of edges whose V0 is `a`: f(a) gets the
 // segment's sum from registers (edges are sorted by V0, so a per-edge
 // f(V0) += ... would chain stores to one address); each f(V1) -= p~ g.
-template <class S, class Fwd>
+template <class S>
 inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
-                               S* __restrict f, Fwd&& fwd) {
+                               S* __restrict f, const ForwardOut<S>& out) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
-    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
-        S* fb = fwd(m.edge[e][1]);
-        const S ge = S(g[e]);
-        const S v0 = p[3 * std::size_t(e)] * ge, v1 = p[3 * std::size_t(e) + 1] * ge, v2 = p[3 * std::size_t(e) + 2] * ge;
-        acc0 += v0;
-        acc1 += v1;
-        acc2 += v2;
-        fb[0] -= v0;
-        fb[1] -= v1;
-        fb[2] -= v2;
-    }
+    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, out,
+                   [&](index_t e, S* fb) {
+                       const S ge = S(g[e]);
+                       const S v0 = p[3 * std::size_t(e)] * ge, v1 = p[3 * std::size_t(e) + 1] * ge,
+                               v2 = p[3 * std::size_t(e) + 2] * ge;
+                       acc0 += v0;
+                       acc1 += v1;
+                       acc2 += v2;
+                       fb[0] -= v0;
+                       fb[1] -= v1;
+                       fb[2] -= v2;
+                   });
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
     f[3 * std::size_t(a) + 2] += acc2;
@@ -119,7 +147,7 @@ inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
 template <class S>
 inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
                                S* __restrict f) {
-    edge_force_segment(m, a, p, g, f, [f](index_t b) { return f + 3 * std::size_t(b); });
+    edge_force_segment(m, a, p, g, f, direct_only(f));
 }
 
 // The TSEP loop and the edge scatter fused, over the segment of edges whose
@@ -253,18 +281,18 @@ struct Xyz4 {
 // registers, as in edge_force_segment). Built-in scalars run it in 4-lane
 // vectors: K(E)^T d as three row-times-broadcast FMAs, K(E) d as lane-wise
 // products summed once per segment (half the scalar version's operations).
-template <class S, class Fwd>
+template <class S>
 inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
-                            S* __restrict y, Fwd&& fwd) {
+                            S* __restrict y, const ForwardOut<S>& out) {
+    const auto V1 = [&m](index_t e) { return m.edge[e][1]; };
     if constexpr (std::is_floating_point_v<S>) {
         using X = Xyz4<S>;
         using V = typename X::V;
         const V xa = X::load(&x[3 * std::size_t(a)]);
         V r0 = {}, r1 = {}, r2 = {};
-        for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
-            const std::size_t b = 3 * std::size_t(m.edge[e][1]);
+        for_segment<3>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
             const S* k = &K[9 * std::size_t(e)];
-            const V d = xa - X::load(&x[b]);
+            const V d = xa - X::load(&x[3 * std::size_t(m.edge[e][1])]);
             const V k0 = X::row(k), k1 = X::row(k + 3), k2 = X::row(k + 6);
             r0 += k0 * d;
             r1 += k1 * d;
@@ -272,9 +300,8 @@ inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restric
             // y(V1) is summed into last: its chain through memory (the next
             // segment often updates the same vertex) stays one add long.
             const V t = d[0] * k0 + d[1] * k1 + d[2] * k2;
-            S* yb = fwd(m.edge[e][1]);
             X::store(yb, X::load(yb) + t);
-        }
+        });
         S* ya = &y[3 * std::size_t(a)];
         ya[0] -= r0[0] + r0[1] + r0[2];
         ya[1] -= r1[0] + r1[1] + r1[2];
@@ -282,18 +309,17 @@ inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restric
     } else {
         const S xa0 = x[3 * std::size_t(a)], xa1 = x[3 * std::size_t(a) + 1], xa2 = x[3 * std::size_t(a) + 2];
         S acc0 = 0, acc1 = 0, acc2 = 0;
-        for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
+        for_segment<3>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
             const index_t b = m.edge[e][1];
             const S* k = &K[9 * std::size_t(e)];
             const S d0 = xa0 - x[3 * std::size_t(b)], d1 = xa1 - x[3 * std::size_t(b) + 1], d2 = xa2 - x[3 * std::size_t(b) + 2];
             acc0 += k[0] * d0 + k[1] * d1 + k[2] * d2;
             acc1 += k[3] * d0 + k[4] * d1 + k[5] * d2;
             acc2 += k[6] * d0 + k[7] * d1 + k[8] * d2;
-            S* yb = fwd(b);
             yb[0] += k[0] * d0 + k[3] * d1 + k[6] * d2;
             yb[1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
             yb[2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
-        }
+        });
         y[3 * std::size_t(a)] -= acc0;
         y[3 * std::size_t(a) + 1] -= acc1;
         y[3 * std::size_t(a) + 2] -= acc2;
@@ -302,7 +328,7 @@ inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restric
 template <class S>
 inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
                             S* __restrict y) {
-    edge_kx_segment(m, a, K, x, y, [y](index_t b) { return y + 3 * std::size_t(b); });
+    edge_kx_segment(m, a, K, x, y, direct_only(y));
 }
 
 // Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
@@ -317,22 +343,22 @@ inline void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict 
         }
 }
 
-// Diagonal blocks over the segment of edges whose V0 is `a` (D(V1) located
-// by fwd, as in the segment kernels above; same operations in the same
+// Diagonal blocks over the segment of edges whose V0 is `a` (D(V1) through
+// `out`, as in the segment kernels above; the same operations in the same
 // order as edge_diagonal over the segment's edges).
-template <class S, class Fwd>
+template <class S>
 inline void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D,
-                                  Fwd&& fwd) {
+                                  const ForwardOut<S>& out) {
     S* da = &D[9 * std::size_t(a)];
-    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
-        const S* k = &K[9 * std::size_t(e)];
-        S* db = fwd(m.edge[e][1]);
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) {
-                da[3 * i + j] -= k[3 * i + j];
-                db[3 * i + j] -= k[3 * j + i];
-            }
-    }
+    for_segment<9>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, out,
+                   [&](index_t e, S* db) {
+                       const S* k = &K[9 * std::size_t(e)];
+                       for (int i = 0; i < 3; ++i)
+                           for (int j = 0; j < 3; ++j) {
+                               da[3 * i + j] -= k[3 * i + j];
+                               db[3 * i + j] -= k[3 * j + i];
+                           }
+                   });
 }
 
 }  // namespace kernel

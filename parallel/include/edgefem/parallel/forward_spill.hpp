@@ -20,6 +20,7 @@
 #include <span>
 #include <vector>
 
+#include "edgefem/core/edge_kernels.hpp"
 #include "edgefem/core/executor.hpp"
 
 namespace edgefem {
@@ -51,8 +52,8 @@ std::vector<index_t> balanced_parts(std::span<const index_t> weight_first, index
 
 // Runs one owner-computes scatter with W values per target: body(part,
 // begin, end, fwd) runs items [begin, end) of the part, writing its own
-// targets in `out` and every forward target t through fwd(t) (a pointer to
-// t's W values). `spill` must hold fs.spill_targets() * W zeros; it is left
+// targets in `out` and its forward targets through the kernel::ForwardOut
+// `fwd` (targets past `end` land in the part's window). `spill` must hold fs.spill_targets() * W zeros; it is left
 // zeroed.
 template <int W, class T, class Body>
 void run_forward_spill(const Executor& ex, const ForwardSpill& fs, T* out, std::vector<T>& spill, Body&& body) {
@@ -60,10 +61,7 @@ void run_forward_spill(const Executor& ex, const ForwardSpill& fs, T* out, std::
     ex.for_phases({P, P}, [&](int phase, index_t p) {
         const index_t begin = fs.part_first[p], end = fs.part_first[p + 1];
         if (phase == 0) {
-            T* const window = spill.data() + W * fs.window_first[p];
-            body(p, begin, end, [=](index_t t) {
-                return t < end ? out + W * std::size_t(t) : window + W * std::size_t(t - end);
-            });
+            body(p, begin, end, kernel::ForwardOut<T>{out, spill.data() + W * fs.window_first[p], end});
             return;
         }
         for (index_t k = fs.in_first[p]; k < fs.in_first[p + 1]; ++k) {

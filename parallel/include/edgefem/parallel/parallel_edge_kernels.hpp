@@ -312,7 +312,7 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
                 });
                 break;
             case Variant::Owner:
-                run_forward_spill<1>(*ex_, espill_, g, spill_g_, [&](index_t, index_t b, index_t e, auto fwd) {
+                run_forward_spill<1>(*ex_, espill_, g, spill_g_, [&](index_t, index_t b, index_t e, const auto& fwd) {
                     for (index_t i = b; i < e; ++i) kernel::tsep_strain_segment(m, i, zeta, g, fwd);
                 });
                 break;
@@ -357,7 +357,7 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
         case Variant::Owner:
             // A part's own range is written by no other part before the
             // barrier, so it is zeroed inside the part's work.
-            run_forward_spill<3>(*ex_, vspill_, f, spill_v_, [&](index_t, index_t b, index_t e, auto fwd) {
+            run_forward_spill<3>(*ex_, vspill_, f, spill_v_, [&](index_t, index_t b, index_t e, const auto& fwd) {
                 std::fill(f + 3 * std::size_t(b), f + 3 * std::size_t(e), S(0));
                 for (index_t a = b; a < e; ++a) kernel::edge_force_segment(m, a, p, g, f, fwd);
             });
@@ -455,7 +455,7 @@ void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S*
             break;
         }
         case Variant::Owner:
-            run_forward_spill<3>(*ex_, vspill_, y, spill_v_, [&](index_t, index_t b, index_t e, auto fwd) {
+            run_forward_spill<3>(*ex_, vspill_, y, spill_v_, [&](index_t, index_t b, index_t e, const auto& fwd) {
                 std::fill(y + 3 * std::size_t(b), y + 3 * std::size_t(e), S(0));
                 for (index_t a = b; a < e; ++a) kernel::edge_kx_segment(m, a, K, x, y, fwd);
             });
@@ -499,7 +499,7 @@ void ParallelEdgeKernels<S>::diagonal_blocks(const EdgeStiffness<S>& Ks, S* D) c
             break;
         }
         case Variant::Owner:
-            run_forward_spill<9>(*ex_, vspill_, D, spill_d_, [&](index_t, index_t b, index_t e, auto fwd) {
+            run_forward_spill<9>(*ex_, vspill_, D, spill_d_, [&](index_t, index_t b, index_t e, const auto& fwd) {
                 std::fill(D + 9 * std::size_t(b), D + 9 * std::size_t(e), S(0));
                 for (index_t a = b; a < e; ++a) kernel::edge_diagonal_segment(m, a, K, D, fwd);
             });
