@@ -72,6 +72,8 @@ TEST(SceneJson, Defaults) {
     EXPECT_EQ(s.solver.load_steps, d.solver.load_steps);
     EXPECT_EQ(s.solver.max_step_halvings, d.solver.max_step_halvings);
     EXPECT_EQ(s.solver.stiffness_interval, 1);
+    EXPECT_EQ(s.solver.max_energy_growth, d.solver.max_energy_growth);
+    EXPECT_EQ(s.solver.max_energy_growth, 1.5);  // the documented default
     EXPECT_EQ(sf.output.dir, "edgefem-out");
     EXPECT_EQ(sf.output.every, 10);
     EXPECT_TRUE(sf.output.vtu);
@@ -100,7 +102,8 @@ TEST(SceneJson, EveryKey) {
         "steps": 1e3,
         "solver": {"linear": "direct", "cg_tolerance": 1e-8, "cg_max_iterations": 77, "cg_fixed_iterations": 5,
                    "definite_stiffness": true, "newton_tolerance": 1e-9, "newton_max_iterations": 12,
-                   "load_steps": 3, "max_step_halvings": 2, "stiffness_interval": 4},
+                   "load_steps": 3, "max_step_halvings": 2, "stiffness_interval": 4,
+                   "fail_on_unconverged": false, "max_energy_growth": 3},
         "output": {"dir": "out/here", "every": 4, "vtu": false}
     })",
                                dir.path());
@@ -138,6 +141,8 @@ TEST(SceneJson, EveryKey) {
     EXPECT_EQ(s.solver.load_steps, 3);
     EXPECT_EQ(s.solver.max_step_halvings, 2);
     EXPECT_EQ(s.solver.stiffness_interval, 4);
+    EXPECT_FALSE(s.solver.fail_on_unconverged);
+    EXPECT_EQ(s.solver.max_energy_growth, 3);
     EXPECT_EQ(sf.output.dir, "out/here");
     EXPECT_EQ(sf.output.every, 4);
     EXPECT_FALSE(sf.output.vtu);
@@ -325,6 +330,14 @@ TEST(SceneJsonErrors, BadValues) {
     expect_error(scene(R"("steps": -5)"), {"\"steps\""});
     expect_error(scene(R"("fixed": {"box": {"min": [5, 5, 5], "max": [6, 6, 6]}})"), {"\"fixed\"", "selects no vertex"});
     expect_error(scene(R"("fixed": [{"vertices": [0]}, {"box": {"min": [5, 5, 5]}}])"), {"\"fixed[1]\"", "selects no vertex"});
+    // The energy guard: 0 (off) or a factor >= 1.
+    EXPECT_EQ(parse(scene(R"("solver": {"max_energy_growth": 0})")).scene.solver.max_energy_growth, 0);
+    EXPECT_EQ(parse(scene(R"("solver": {"max_energy_growth": 1})")).scene.solver.max_energy_growth, 1);
+    EXPECT_EQ(expect_error(scene(R"("solver": {"max_energy_growth": 0.5})"), {}),
+              "scene.json: \"solver.max_energy_growth\": expected 0 (off) or a number >= 1, got 0.5");
+    expect_error(scene(R"("solver": {"max_energy_growth": -2})"), {"\"solver.max_energy_growth\"", "non-negative", "-2"});
+    expect_error(scene(R"("solver": {"max_energy_growth": "2"})"), {"\"solver.max_energy_growth\"", "number"});
+    expect_error(scene(R"("solver": {"max_energy_grow": 2})"), {"\"solver.max_energy_grow\"", "unknown key", "max_energy_growth"});
     // Whole-scene checks (Scene::validate) keep the file name.
     expect_error(scene(R"("model": "sn", "method": "tet")"), {"scene.json", "model"});
 }

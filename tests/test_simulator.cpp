@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include "edgefem/core/cg.hpp"
 #include "edgefem/core/elastic_operator.hpp"
@@ -191,6 +193,22 @@ TEST(Simulator, DefiniteTangentKeepsCgConvergentOnCompressedCube) {
     for (index_t v = 0; v < mesh.num_vertices(); ++v)
         if (mesh.X[3 * v + 2] < -0.02 + 1e-9) s.fixed.push_back(v);
     s.dt = 0.05;
+    // That step multiplies the energy by ~30 (a linearised step this large
+    // from a compressed state is no physics): the energy guard rejects it...
+    {
+        Simulator<double> guarded(s);
+        std::copy(u.begin(), u.end(), guarded.displacement().begin());
+        for (index_t v : s.fixed)
+            for (int r = 0; r < 3; ++r) guarded.displacement()[3 * v + r] = 0;
+        try {
+            guarded.step();
+            ADD_FAILURE() << "the energy guard let a 30x energy gain through";
+        } catch (const SimulationError& e) {
+            EXPECT_NE(std::string(e.what()).find("step 1: energy grew without a source"), std::string::npos) << e.what();
+        }
+    }
+    // ...so the negative-curvature handling is checked with it off.
+    s.solver.max_energy_growth = 0;
     Simulator<double> sim(s);
     std::copy(u.begin(), u.end(), sim.displacement().begin());
     for (index_t v : s.fixed)
@@ -350,4 +368,223 @@ TEST(Simulator, UnconvergedSolvesAreCountedOrFatal) {
     s.solver.cg_max_iterations = 5000;  // enough: no count, no error
     Simulator<double> enough(s);
     EXPECT_EQ(enough.step().unconverged_solves, 0);
+}
+
+// ---- The energy guard (SolverSettings::max_energy_growth) -----------------
+
+// An explicit step above the stability limit makes the energy grow
+// geometrically: the guard stops it with an error naming the step, the
+// growth and the fastest vertex while the state is still finite, steps
+// before the state turns non-finite (which is what stops it with the guard
+// off).
+TEST(Simulator, EnergyGuardStopsAnUnstableExplicitRunBeforeItIsNonFinite) {
+    Scene s = cantilever(Integrator::Explicit, 4e-3);  // a few times the stable step
+    ASSERT_GT(s.solver.max_energy_growth, 0);           // on by default
+    auto fail_step = [](Scene sc, std::string& msg) {
+        Simulator<double> sim(std::move(sc));
+        try {
+            for (int k = 0; k < 2000; ++k) sim.step();
+        } catch (const SimulationError& e) {
+            msg = e.what();
+            EXPECT_GE(e.vertex(), 0);
+            EXPECT_NE(msg.find("vertex " + std::to_string(e.vertex())), std::string::npos) << msg;
+            const bool by_guard = msg.find("energy grew") != std::string::npos;
+            for (double x : sim.displacement()) {
+                if (by_guard) {
+                    EXPECT_TRUE(std::isfinite(x)) << msg;  // caught while the state is still finite
+                }
+            }
+            return e.step();
+        }
+        ADD_FAILURE() << "no error";
+        return 0L;
+    };
+    std::string guarded, unguarded;
+    const long at_guard = fail_step(s, guarded);
+    s.solver.max_energy_growth = 0;
+    const long at_nan = fail_step(s, unguarded);
+    EXPECT_NE(guarded.find("step " + std::to_string(at_guard) + ": energy grew without a source: +"), std::string::npos)
+        << guarded;
+    EXPECT_NE(guarded.find("over solver.max_energy_growth = 1.5; fastest vertex "), std::string::npos) << guarded;
+    EXPECT_NE(unguarded.find("non-finite"), std::string::npos) << unguarded;
+    EXPECT_LT(at_guard, at_nan);
+    EXPECT_GT(at_guard, 1);
+
+    // With step halving the guard's failure is retried with smaller steps
+    // like any other failed step: the run goes on.
+    s.solver.max_energy_growth = 1.5;
+    s.solver.max_step_halvings = 4;
+    Simulator<double> halving(s);
+    int halvings = 0;
+    for (int k = 0; k < at_guard + 20; ++k) halvings += halving.step().halvings;
+    EXPECT_GT(halvings, 0);
+    for (double x : halving.displacement()) ASSERT_TRUE(std::isfinite(x));
+}
+
+// Normal runs never trip it: a beam swinging under gravity (explicit at a
+// stable step; semi-implicit and implicit with 1% slack: backward Euler is
+// (nearly) dissipative), a body pushed by an external
+// force from rest (its energy comes from the force's work), a prescribed
+// ramp (constraint work: not checked) and velocities the application sets
+// between steps (part of the next step's starting energy).
+TEST(Simulator, EnergyGuardLetsNormalRunsThrough) {
+    {
+        Simulator<double> sim(cantilever(Integrator::Explicit, 2e-5));
+        for (int k = 0; k < 3000; ++k) ASSERT_NO_THROW(sim.step()) << k;
+    }
+    for (Integrator integ : {Integrator::SemiImplicit, Integrator::Implicit}) {
+        SCOPED_TRACE(to_string(integ));
+        Scene s = cantilever(integ, 2e-3);
+        // Backward Euler dissipates where W is convex; in this swing's large
+        // rotations StVK is not, and the implicit step gains ~0.1% of the
+        // swing's energy over 100 steps: 1% slack, far below the default.
+        s.solver.max_energy_growth = 1.01;
+        Simulator<double> sim(s);
+        for (int k = 0; k < 100; ++k) ASSERT_NO_THROW(sim.step()) << k;
+        EXPECT_GT(sim.energies().kinetic, 0);
+    }
+    for (Integrator integ : {Integrator::Explicit, Integrator::SemiImplicit, Integrator::Implicit}) {
+        SCOPED_TRACE(to_string(integ));
+        Scene s = cantilever(integ, integ == Integrator::Explicit ? 2e-5 : 1e-3);
+        s.gravity = {0, 0, 0};
+        s.solver.max_energy_growth = integ == Integrator::Explicit ? 1.05 : 1.01;
+        Simulator<double> sim(s);
+        auto fext = sim.external_forces();
+        for (index_t v = 0; v < sim.num_vertices(); ++v)
+            if (s.mesh.X[3 * v] > 0.04 - 1e-9) fext[3 * v + 2] = 0.01;  // the free end pulled up
+        const int steps = integ == Integrator::Explicit ? 2000 : 40;
+        for (int k = 0; k < steps; ++k) ASSERT_NO_THROW(sim.step()) << k;
+        EXPECT_GT(sim.energies().kinetic + sim.energies().elastic, 0);
+        // The application kicks the body: not the step's doing.
+        for (auto& x : sim.velocity()) x += 0.05;
+        for (int k = 0; k < 5; ++k) ASSERT_NO_THROW(sim.step()) << k;
+    }
+    {
+        Scene s = cantilever(Integrator::SemiImplicit, 1e-3);
+        s.gravity = {0, 0, 0};
+        s.solver.max_energy_growth = 1.01;
+        for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+            if (s.mesh.X[3 * v] > 0.04 - 1e-9)
+                s.prescribed.push_back({v, {s.mesh.X[3 * v], s.mesh.X[3 * v + 1], s.mesh.X[3 * v + 2] + 0.01}});
+        s.prescribed_steps = 20;
+        Simulator<double> sim(s);
+        for (int k = 0; k < 60; ++k) ASSERT_NO_THROW(sim.step()) << k;
+        EXPECT_GT(sim.energies().elastic, 0);
+    }
+}
+
+// A fixed CG budget (a haptic loop's partial solve) is not dissipative: the
+// guard measures it (StepStats::energy_growth) but never fails it, as
+// fail_on_unconverged never does.
+TEST(Simulator, EnergyGuardMeasuresButNeverFailsAFixedCgBudget) {
+    Scene s = cantilever(Integrator::SemiImplicit, 2e-3);
+    s.solver.cg_fixed_iterations = 1;
+    s.solver.max_energy_growth = 1;  // no slack at all
+    Simulator<double> sim(s);
+    double most = 0;
+    for (int k = 0; k < 200; ++k) {
+        const StepStats& st = sim.step();
+        EXPECT_GE(st.energy_growth, 1.0) << k;
+        most = std::max(most, st.energy_growth);
+    }
+    EXPECT_GT(most, 1.0);  // it did gain energy: an unchecked partial solve would have failed
+    s.solver.cg_fixed_iterations = 0;
+    s.solver.max_energy_growth = 0;
+    Simulator<double> off(s);
+    EXPECT_EQ(off.step().energy_growth, 0);  // guard off: not measured
+}
+
+namespace {
+
+// Core's operator with deterministic noise of relative size `jitter` (of
+// the forces' rms) added to every force evaluation: a residual floor, as
+// round-off makes one on stiff or badly shaped meshes.
+class JitterOperator final : public ElasticOperator<double> {
+public:
+    JitterOperator(std::unique_ptr<ElasticOperator<double>> op, double jitter) : op_(std::move(op)), jitter_(jitter) {}
+    index_t num_vertices() const override { return op_->num_vertices(); }
+    double forces(const double* u, double* f, bool energy) override {
+        const double W = op_->forces(u, f, energy);
+        const std::size_t n = 3 * std::size_t(num_vertices());
+        double rms = 0;
+        for (std::size_t i = 0; i < n; ++i) rms += f[i] * f[i];
+        rms = std::sqrt(rms / double(n));
+        ++calls_;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double h = std::sin(12.9898 * double(i) + 78.233 * double(calls_)) * 43758.5453;
+            f[i] += jitter_ * rms * 2 * (h - std::floor(h) - 0.5);
+        }
+        return W;
+    }
+    double energy(const double* u) override { return op_->energy(u); }
+    void build_stiffness(bool definite) override { op_->build_stiffness(definite); }
+    void multiply(const double* x, double* y) const override { op_->multiply(x, y); }
+    void diagonal_blocks(double* D) const override { op_->diagonal_blocks(D); }
+    void for_each_block(void (*visit)(void*, index_t, index_t, const double*), void* ctx) const override {
+        op_->for_each_block(visit, ctx);
+    }
+    index_t inverted_tets(const double* u) const override { return op_->inverted_tets(u); }
+
+private:
+    std::unique_ptr<ElasticOperator<double>> op_;
+    double jitter_;
+    long calls_ = 0;
+};
+
+OperatorFactory<double> jitter_factory(double jitter) {
+    return [jitter](const Mesh& m, const Materials& mat, ModelKind k, Method me) -> std::unique_ptr<ElasticOperator<double>> {
+        return std::make_unique<JitterOperator>(make_elastic_operator<double>(m, mat, k, me), jitter);
+    };
+}
+
+}  // namespace
+
+// Newton stagnating at a round-off floor above newton_tolerance is
+// converged (and says so); one stuck far above round-off still fails with
+// its residual in the message.
+TEST(Simulator, NewtonAcceptsItsRoundOffFloorButNotAStuckSolve) {
+    Scene s = cantilever(Integrator::Implicit, 2e-3);
+    s.solver.newton_tolerance = 1e-14;  // below the floor the jitter makes
+    Simulator<double> clean(s);
+    Simulator<double> floor(s, nullptr, jitter_factory(1e-12));
+    for (int k = 0; k < 5; ++k) {
+        clean.step();
+        const StepStats& st = floor.step();
+        EXPECT_TRUE(st.newton_round_off) << k;
+        EXPECT_LE(st.residual, std::sqrt(std::numeric_limits<double>::epsilon()));
+        EXPECT_GT(st.residual, s.solver.newton_tolerance);
+    }
+    double diff = 0, ref = 0;
+    for (std::size_t i = 0; i < clean.displacement().size(); ++i) {
+        diff = std::max(diff, std::abs(clean.displacement()[i] - floor.displacement()[i]));
+        ref = std::max(ref, std::abs(clean.displacement()[i]));
+    }
+    EXPECT_LT(diff, 1e-8 * ref);
+
+    // The static solve shares the criterion.
+    Scene st = cantilever(Integrator::Implicit, 2e-3);
+    st.solver.newton_tolerance = 1e-14;
+    Simulator<double> stat(st, nullptr, jitter_factory(1e-12));
+    const StaticResult res = stat.solve_static();
+    EXPECT_TRUE(res.converged);
+    EXPECT_TRUE(stat.last_stats().newton_round_off);
+
+    // A residual stuck at ~1e-4: a failure, whichever way Newton gives up.
+    s.solver.newton_tolerance = 1e-10;
+    Simulator<double> stuck(s, nullptr, jitter_factory(1e-3));
+    try {
+        stuck.step();
+        FAIL() << "no error; residual " << stuck.last_stats().residual;
+    } catch (const SimulationError& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("step 1: "), std::string::npos) << msg;
+        EXPECT_NE(msg.find("relative residual"), std::string::npos) << msg;
+        EXPECT_FALSE(stuck.last_stats().newton_round_off);
+    }
+    // Clean solves converge to the tolerance, not the floor.
+    Scene ok = cantilever(Integrator::Implicit, 2e-3);
+    Simulator<double> plain(ok);
+    const StepStats& ps = plain.step();
+    EXPECT_FALSE(ps.newton_round_off);
+    EXPECT_LE(ps.residual, ok.solver.newton_tolerance);
 }

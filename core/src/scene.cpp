@@ -54,6 +54,8 @@ void Scene::validate() const {
     if (solver.load_steps < 1) bad("solver.load_steps", "must be >= 1");
     if (solver.max_step_halvings < 0) bad("solver.max_step_halvings", "must be >= 0");
     if (solver.stiffness_interval < 1) bad("solver.stiffness_interval", "must be >= 1");
+    if (!std::isfinite(solver.max_energy_growth) || (solver.max_energy_growth != 0 && !(solver.max_energy_growth >= 1)))
+        bad("solver.max_energy_growth", "must be 0 (off) or a finite number >= 1, got " + std::to_string(solver.max_energy_growth));
     std::vector<char> seen(nv, 0);
     for (std::size_t i = 0; i < fixed.size(); ++i) {
         if (fixed[i] < 0 || fixed[i] >= nv)

@@ -325,7 +325,7 @@ void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     check_keys(cx, v, p,
                {"linear", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "definite_stiffness",
                 "newton_tolerance", "newton_max_iterations", "load_steps", "max_step_halvings",
-                "stiffness_interval", "fail_on_unconverged"});
+                "stiffness_interval", "fail_on_unconverged", "max_energy_growth"});
     if (const json* x = find(v, "linear"))
         s.linear_solver = get_enum<LinearSolver>(cx, *x, join(p, "linear"), {{"cg", LinearSolver::CG}, {"direct", LinearSolver::Direct}});
     if (const json* x = find(v, "cg_tolerance")) s.cg_tolerance = get_number(cx, *x, join(p, "cg_tolerance"), Range::Positive);
@@ -338,6 +338,11 @@ void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     if (const json* x = find(v, "load_steps")) s.load_steps = get_int(cx, *x, join(p, "load_steps"), 1);
     if (const json* x = find(v, "max_step_halvings")) s.max_step_halvings = get_int(cx, *x, join(p, "max_step_halvings"), 0);
     if (const json* x = find(v, "stiffness_interval")) s.stiffness_interval = get_int(cx, *x, join(p, "stiffness_interval"), 1);
+    if (const json* x = find(v, "max_energy_growth")) {
+        const std::string key = join(p, "max_energy_growth");
+        s.max_energy_growth = get_number(cx, *x, key, Range::NonNegative);
+        if (s.max_energy_growth != 0 && s.max_energy_growth < 1) cx.fail(key, "expected 0 (off) or a number >= 1, got " + show(*x));
+    }
 }
 
 void read_output(const Context& cx, const json& v, OutputSettings& o) {

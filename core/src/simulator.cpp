@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -55,6 +56,70 @@ bool spd_inverse3(const double (&B)[3][3], double* inv) {
     return true;
 }
 
+// Three sums over [0, n) in one pass: term(i, acc) adds to acc[0..2].
+// Per-block partials added in block order, as blocked_sum: the same for any
+// thread count.
+template <class Term>
+std::array<double, 3> blocked_sum3(const Executor& ex, std::size_t n, Term&& term) {
+    std::vector<std::array<double, 3>> partial((n + kVectorChunk - 1) / kVectorChunk, {0.0, 0.0, 0.0});
+    for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) {
+        double acc[3] = {0, 0, 0};
+        for (std::size_t i = lo; i < hi; ++i) term(i, acc);
+        partial[lo / kVectorChunk] = {acc[0], acc[1], acc[2]};
+    });
+    std::array<double, 3> s{0.0, 0.0, 0.0};
+    for (const auto& p : partial)
+        for (int k = 0; k < 3; ++k) s[k] += p[k];
+    return s;
+}
+
+// Sums of squares and products for Newton without underflow: a damped
+// body's motion decays to 1e-160 m and below, whose squares leave the double
+// range (a zero slope, a zero norm, a Newton iteration of noise). Each
+// vector is scaled by a power of two near its largest entry first (exact);
+// the result is mant x 2^exp. A non-finite entry makes it non-finite.
+struct Scaled {
+    double mant = 0;
+    int exp = 0;
+    double value() const { return std::ldexp(mant, exp); }
+};
+
+template <class Term>
+int max_exponent(std::size_t n, Term&& term, double& bad) {
+    double mx = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double t = std::abs(term(i));
+        if (!std::isfinite(t)) bad = t;
+        mx = std::max(mx, t);
+    }
+    return mx > 0 ? std::ilogb(mx) : 0;
+}
+
+template <class A, class B>
+Scaled scaled_dot(std::size_t n, A&& a, B&& b) {
+    double bad = 0;
+    const int ea = max_exponent(n, a, bad), eb = max_exponent(n, b, bad);
+    if (bad != 0) return {bad, 0};
+    double s = 0;
+    for (std::size_t i = 0; i < n; ++i) s += std::ldexp(a(i), -ea) * std::ldexp(b(i), -eb);
+    return {s, ea + eb};
+}
+
+template <class Term>
+double scaled_norm(std::size_t n, Term&& term) {
+    const Scaled s = scaled_dot(n, term, term);
+    return std::isfinite(s.mant) ? std::ldexp(std::sqrt(s.mant), s.exp / 2) : s.mant;
+}
+
+// The energy guard's view of a state (SolverSettings::max_energy_growth).
+struct EnergySample {
+    double kinetic = 0, elastic = 0;
+    double gravity = 0;  // -m g.u (the constant -m g.X left out: only differences count)
+    double load = 0;     // f_ext.u with the step's f_ext: its change is the external work
+    double total() const { return kinetic + elastic + gravity; }
+    double magnitude() const { return kinetic + std::abs(elastic) + std::abs(gravity) + std::abs(load); }
+};
+
 // A failed step, caught to retry with a halved step.
 struct StepFailure {
     std::string message;
@@ -87,6 +152,15 @@ struct Simulator<S>::Impl {
     std::vector<double> newton_d;   // u - u0 in Newton's residual
     CgWork cg;
     std::vector<index_t> dof_index;
+
+    // Energy guard (SolverSettings::max_energy_growth).
+    std::vector<S> u_evaluated;    // the u that f, the operator's state and W_evaluated belong to
+    double W_evaluated = 0;
+    bool evaluated_valid = false;
+    bool forces_current = false;   // f is at the step's starting u: the step skips its force pass
+    double energy_excess = 0;      // energy gained net of work since its lowest level (>= 0)
+    double energy_scale = 0;       // largest kinetic + elastic energy seen
+    double newton_W = 0;           // elastic energy at Newton's last evaluation
 
     std::size_t n() const { return u.size(); }
 
@@ -216,6 +290,24 @@ struct Simulator<S>::Impl {
         return res;
     }
 
+    // A power of two s with b / s and the mass part of A x / s near 1 when
+    // they are extreme, else 1. CG's dot products square its vectors: for a
+    // body whose motion has decayed to 1e-150 m they underflow into
+    // subnormals and CG breaks down (false negative curvature, a Newton
+    // direction of noise). Scaling by a power of two is exact, so a solve
+    // that needs no scaling is unchanged.
+    double solve_scale(double c_m) const {
+        double bmax = 0, xmax = 0, mmax = 0;
+        for (std::size_t i = 0; i < n(); ++i) {
+            if (free_dof[i]) bmax = std::max(bmax, std::abs(b[i]));
+            xmax = std::max(xmax, std::abs(x[i]));
+        }
+        for (double m : mass) mmax = std::max(mmax, m);
+        const double mag = std::max(bmax, c_m * mmax * xmax);
+        if (!(mag > 0) || !std::isfinite(mag) || (mag > 0x1p-100 && mag < 0x1p100)) return 1;
+        return std::ldexp(1.0, std::ilogb(mag));
+    }
+
     CgResult solve_once(double c_m, double c_k, double c_b, double tolerance, bool definite,
                         bool reuse_stiffness = false) {
         auto t0 = Clock::now();
@@ -257,6 +349,11 @@ struct Simulator<S>::Impl {
         if (!reuse_stiffness) build_preconditioner(c_m, c_k, c_b);
         stats.stiffness_ms += ms_since(t0);
         t0 = Clock::now();
+        const double s = solve_scale(c_m);
+        if (s != 1) each([&](std::size_t i) {
+            b[i] /= s;
+            x[i] /= s;
+        });
         res = conjugate_gradient(
             *exec, n(), free_dof.data(), [&](const double* in, double* out) { apply_system(c_m, c_k, c_b, in, out); },
             [&](const double* r, double* z) {
@@ -267,6 +364,10 @@ struct Simulator<S>::Impl {
                 });
             },
             b.data(), x.data(), tolerance, scene.solver.cg_max_iterations, scene.solver.cg_fixed_iterations, cg);
+        if (s != 1) each([&](std::size_t i) {
+            b[i] *= s;
+            x[i] *= s;
+        });
         stats.solve_ms += ms_since(t0);
         stats.solver_iterations += res.iterations;
         return res;
@@ -277,6 +378,111 @@ struct Simulator<S>::Impl {
         const double W = op->forces(u.data(), f.data(), energy);
         stats.force_ms += ms_since(t0);
         return W;
+    }
+
+    // The internal forces at the step's start, unless the energy guard has
+    // just evaluated them at this state.
+    void start_forces() {
+        if (!forces_current) forces(false);
+        forces_current = false;
+    }
+
+    EnergySample sample(double W) const {
+        const std::array<double, 3> s = blocked_sum3(*exec, n(), [&](std::size_t i, double* acc) {
+            const double m = mass[i / 3], vi = double(v[i]), ui = double(u[i]);
+            acc[0] += 0.5 * m * vi * vi;
+            acc[1] -= m * scene.gravity[i % 3] * ui;
+            acc[2] += double(fext[i]) * ui;
+        });
+        return {s[0], W, s[1], s[2]};
+    }
+
+    // The state at the start of a step. The elastic energy comes from the
+    // guard's force pass at the end of the last step when u is unchanged
+    // since (then f is current too and the step skips its force pass), else
+    // from a force pass here. Edits the application made between steps are
+    // thereby part of the starting energy, not of the step's gain.
+    EnergySample energy_at_start() {
+        const bool same = evaluated_valid && std::equal(u.begin(), u.end(), u_evaluated.begin());
+        const double W = same ? W_evaluated : forces(true);
+        forces_current = true;
+        return sample(W);
+    }
+
+    // Whether a step from the current state to t_end moves a fixed or
+    // prescribed vertex (a prescribed ramp, or a vertex the application
+    // displaced): the constraint's work is unknown, so the guard skips it.
+    bool constraints_move(double t_end) const {
+        const double s = ramp(t_end), tol = 8 * double(std::numeric_limits<S>::epsilon());
+        for (std::size_t k = 0; k < con_vertex.size(); ++k)
+            for (int r = 0; r < 3; ++r) {
+                const double target = s * con_disp[k][r], cur = double(u[3 * std::size_t(con_vertex[k]) + r]);
+                if (std::abs(target - cur) > tol * (std::abs(target) + std::abs(cur))) return true;
+            }
+        return false;
+    }
+
+    // The energy guard after a step of size T that started at `start` and
+    // ends with elastic energy W_end. The step's gain is its energy change
+    // net of the external work (f_ext is constant over the step: f_ext.du)
+    // and of what mass damping removed (every integrator applies alpha M v
+    // with the new velocity over du = T v: 2 T alpha x kinetic energy), so it
+    // is the integrator's own energy error: damping does not hide an
+    // injection. Gains accumulate from their lowest level (a one-sided
+    // CUSUM: dissipation is no credit for later injection) and may not
+    // exceed (max_energy_growth - 1) x the largest kinetic + elastic energy
+    // the body has had net of such gains, plus the sums' round-off.
+    void check_energy(double T, const EnergySample& start, double W_end, bool constraints_moved) {
+        u_evaluated.assign(u.begin(), u.end());
+        W_evaluated = W_end;
+        evaluated_valid = true;
+        const EnergySample end = sample(W_end);
+        const double scale = std::max(energy_scale, start.kinetic + start.elastic);
+        double excess = energy_excess;
+        if (!constraints_moved) {
+            const double damping = 2 * T * scene.rayleigh_alpha * end.kinetic;
+            const double gain = (end.total() - start.total()) - (end.load - start.load) + damping;
+            const double noise = 256 * double(std::numeric_limits<S>::epsilon()) * (start.magnitude() + end.magnitude());
+            excess += gain;
+            const double limit = scene.solver.max_energy_growth;
+            stats.energy_growth = 1 + std::max(excess, 0.0) / std::max(scale, 1e-300);
+            // A fixed CG budget is a deliberate partial solve, which is not
+            // dissipative: measured, never failed (as fail_on_unconverged).
+            const bool partial = scene.integrator == Integrator::SemiImplicit && scene.solver.cg_fixed_iterations > 0 &&
+                                 scene.solver.linear_solver == LinearSolver::CG;
+            if (!partial && !(excess <= (limit - 1) * scale + noise)) {  // NaN included
+                const index_t vertex = fastest_vertex();
+                char ratio[48], lim[32];
+                std::snprintf(ratio, sizeof ratio, "+%.3g x", excess / std::max(scale, 1e-300));
+                std::snprintf(lim, sizeof lim, "%g", limit);
+                throw StepFailure{"step " + std::to_string(step + 1) + ": energy grew without a source: " + ratio +
+                                      " the largest kinetic + elastic energy seen (a gain of " + sci(excess) +
+                                      " J net of the external work since its lowest level; largest " + sci(scale) +
+                                      " J), over solver.max_energy_growth = " + lim + "; fastest vertex " +
+                                      std::to_string(vertex) +
+                                      " (unstable: reduce dt, use the implicit integrator or improve the mesh's worst tets)",
+                                  vertex};
+            }
+            excess = std::max(0.0, excess);
+        }
+        if (constraints_moved) stats.energy_growth = 1 + excess / std::max(scale, 1e-300);
+        energy_excess = excess;
+        energy_scale = std::max(scale, end.kinetic + end.elastic - excess);
+    }
+
+    // The vertex with the largest speed (for messages).
+    index_t fastest_vertex() const {
+        index_t best = 0;
+        double top = -1;
+        for (std::size_t vtx = 0; vtx < mass.size(); ++vtx) {
+            const double s2 = double(v[3 * vtx]) * double(v[3 * vtx]) + double(v[3 * vtx + 1]) * double(v[3 * vtx + 1]) +
+                              double(v[3 * vtx + 2]) * double(v[3 * vtx + 2]);
+            if (s2 > top) {
+                top = s2;
+                best = index_t(vtx);
+            }
+        }
+        return best;
     }
 
     void check_finite(long step_no) const {
@@ -311,7 +517,7 @@ struct Simulator<S>::Impl {
     }
 
     void explicit_step(double T) {
-        forces(false);
+        start_forces();
         external(1.0);
         const double damp = 1 + T * scene.rayleigh_alpha;
         each([&](std::size_t i) { x[i] = (double(v[i]) + T * (h[i] - double(f[i])) / mass[i / 3]) / damp; });
@@ -323,7 +529,7 @@ struct Simulator<S>::Impl {
     }
 
     void semi_implicit_step(double T) {
-        forces(false);
+        start_forces();
         external(1.0);
         const double c_m = 1 + T * scene.rayleigh_alpha, c_k = T * scene.rayleigh_beta + T * T;
         each([&](std::size_t i) {
@@ -361,13 +567,15 @@ struct Simulator<S>::Impl {
         const double c_m = dynamic ? 1 / (T * T) + scene.rayleigh_alpha / T : 0.0;
         const double c_b = dynamic ? scene.rayleigh_beta / T : 0.0;
         const auto& sv = scene.solver;
-        std::vector<double> R(n()), du(n()), trial(n()), K0d(n());
+        std::vector<double> R(n()), du(n()), trial(n()), K0d(n()), inertia(n());
 
-        // Potential and residual at the current u (u, f updated).
-        auto evaluate = [&](double& phi, double& scale) {
+        // Potential, its magnitude (sum of the terms' sizes: its round-off
+        // is ~1e-14 of that) and the residual at the current u (u, f updated).
+        auto evaluate = [&](double& phi, double& scale, double& mag) {
             const double W = forces(true);
+            newton_W = W;
             phi = W;
-            double fn = 0, hn = 0, in = 0;
+            mag = std::abs(W);
             std::vector<double>& d = newton_d;
             d.resize(n());
             for (std::size_t i = 0; i < n(); ++i) d[i] = double(u[i]) - (dynamic ? u0[i] : 0.0);
@@ -375,34 +583,75 @@ struct Simulator<S>::Impl {
             for (std::size_t i = 0; i < n(); ++i) {
                 double r = double(f[i]) - h[i];
                 phi -= h[i] * double(u[i]);
-                fn += double(f[i]) * double(f[i]);
-                hn += h[i] * h[i];
+                mag += std::abs(h[i] * double(u[i]));
+                inertia[i] = 0;
                 if (dynamic) {
                     const double m = mass[i / 3], e = double(u[i]) - upred[i];
-                    const double inertia = m * e / (T * T) + scene.rayleigh_alpha * m * d[i] / T + c_b * K0d[i];
-                    r += inertia;
-                    in += inertia * inertia;
-                    phi += 0.5 * m * e * e / (T * T) + 0.5 * scene.rayleigh_alpha * m * d[i] * d[i] / T +
-                           0.5 * c_b * d[i] * K0d[i];
+                    inertia[i] = m * e / (T * T) + scene.rayleigh_alpha * m * d[i] / T + c_b * K0d[i];
+                    r += inertia[i];
+                    const double kin = 0.5 * m * e * e / (T * T) + 0.5 * scene.rayleigh_alpha * m * d[i] * d[i] / T +
+                                       0.5 * c_b * d[i] * K0d[i];
+                    phi += kin;
+                    mag += std::abs(kin);
                 }
                 R[i] = free_dof[i] ? r : 0.0;
             }
-            scale = std::sqrt(fn) + std::sqrt(hn) + std::sqrt(in);
+            scale = scaled_norm(n(), [&](std::size_t i) { return double(f[i]); }) +
+                    scaled_norm(n(), [&](std::size_t i) { return h[i]; }) +
+                    scaled_norm(n(), [&](std::size_t i) { return inertia[i]; });
+        };
+        auto norm = [&](const std::vector<double>& a) {
+            return scaled_norm(n(), [&](std::size_t i) { return a[i]; });
+        };
+        // du.R: its sign from the scaled sum (the value may underflow).
+        auto slope_of = [&](bool& descent) {
+            const Scaled sl = scaled_dot(n(), [&](std::size_t i) { return x[i]; }, [&](std::size_t i) { return R[i]; });
+            descent = sl.mant < 0;
+            return sl.value();
         };
 
         // The residual cannot fall below the round-off of S: a float model
         // is converged at ~1e-5 whatever the scene asks.
         const double tolerance = std::max(sv.newton_tolerance, 100 * double(std::numeric_limits<S>::epsilon()));
-        double phi = 0, scale = 0;
-        evaluate(phi, scale);
+        // Forces near the smallest normal number of S (a body whose motion
+        // has decayed to ~1e-300 m) have no relative precision left: a
+        // residual below that is zero.
+        const double underflow = std::sqrt(double(n())) * double(std::numeric_limits<S>::min());
+        // Round-off floor. Each force component sums per-edge terms that can
+        // be far larger than their sum (stiff materials, slivers, a
+        // compressed body), so round-off leaves a residual that can lie
+        // above the tolerance. Newton stagnating there is converged:
+        //  (b) the relative residual is at most sqrt(eps) and two iterations
+        //      in a row did not halve the best one (near a solution a Newton
+        //      step gains orders of magnitude: what it cannot reduce is
+        //      noise), or the line search cannot reduce it either;
+        //  (c) the Newton step is below the resolution of u itself
+        //      (|du| <= 8 eps |u|) and the residual did not halve, or the
+        //      line search cannot reduce it: no iteration can change the
+        //      state any more. (At equilibrium under no load the net forces
+        //      vanish while their terms do not: the relative residual there
+        //      can be large and is still noise.)
+        // docs/scenes.md, "Solver settings".
+        const double eps = double(std::numeric_limits<S>::epsilon());
+        const double floor_tolerance = std::sqrt(eps);
+        double best = INFINITY;
+        int stalled = 0;
+        auto at_floor = [&] {
+            if (stats.residual > floor_tolerance) return false;
+            stats.newton_round_off = true;
+            return true;
+        };
+        double phi = 0, scale = 0, mag = 0;
+        evaluate(phi, scale, mag);
         for (int it = 0;; ++it) {
-            double rn = 0;
-            for (double r : R) rn += r * r;
-            rn = std::sqrt(rn);
+            const double rn = norm(R);
             stats.residual = scale > 0 ? rn / scale : rn;
             if (!std::isfinite(rn))
                 throw StepFailure{"step " + std::to_string(step + 1) + ": non-finite residual in Newton", -1};
-            if (rn <= tolerance * scale) return;
+            if (rn <= tolerance * scale || rn <= underflow) return;
+            stalled = stats.residual > 0.5 * best ? stalled + 1 : 0;
+            best = std::min(best, stats.residual);
+            if (stalled >= 2 && at_floor()) return;
             if (it == sv.newton_max_iterations)
                 throw StepFailure{"step " + std::to_string(step + 1) + ": Newton did not converge in " +
                                       std::to_string(sv.newton_max_iterations) + " iterations (relative residual " +
@@ -416,39 +665,64 @@ struct Simulator<S>::Impl {
             }
             const double eta = std::min(1e-2, std::max(1e-12, rn / std::max(scale, 1e-300)));
             solve(c_m, 1.0, c_b, eta, sv.definite_stiffness);
-            double slope = 0;
-            for (std::size_t i = 0; i < n(); ++i) slope += x[i] * R[i];
-            if (!(slope < 0) || !std::isfinite(slope)) {  // not a descent direction: use the definite K
+            bool descent = false, newton_direction = true;
+            double slope = slope_of(descent);
+            if (!descent || !std::isfinite(slope)) {  // not a descent direction: use the definite K
                 if (scene.method == Method::Edge) {
                     for (std::size_t i = 0; i < n(); ++i) x[i] = 0;
                     solve_once(c_m, 1.0, c_b, eta, true);
-                    slope = 0;
-                    for (std::size_t i = 0; i < n(); ++i) slope += x[i] * R[i];
+                    slope = slope_of(descent);
                 }
-                if (!(slope < 0)) {  // last resort: scaled gradient
-                    slope = 0;
-                    for (std::size_t i = 0; i < n(); ++i) {
-                        x[i] = -R[i] / (mass[i / 3] * std::max(c_m, 1.0));
-                        slope += x[i] * R[i];
-                    }
+                if (!descent) {  // last resort: scaled gradient
+                    newton_direction = false;
+                    for (std::size_t i = 0; i < n(); ++i) x[i] = -R[i] / (mass[i / 3] * std::max(c_m, 1.0));
+                    slope = slope_of(descent);
                 }
             }
             du.assign(x.begin(), x.end());
-            // Backtracking line search (Armijo) on the potential.
             for (std::size_t i = 0; i < n(); ++i) trial[i] = double(u[i]);
-            double step_len = 1, phi_new = 0, scale_new = 0;
+            const bool below_resolution = newton_direction && norm(du) <= 8 * eps * norm(trial);
+            if (below_resolution && stalled >= 1) {  // (c)
+                stats.newton_round_off = true;
+                return;
+            }
+            // Backtracking line search: Armijo on the potential while it can
+            // resolve the decrease asked for; below ~1e4 x its round-off (near
+            // the solution, or at tiny steps) the potential's differences are
+            // noise and the residual norm is the merit instead (du is a
+            // descent direction for it too).
+            double step_len = 1, phi_new = 0, scale_new = 0, mag_new = 0;
             for (int ls = 0;; ++ls) {
                 for (std::size_t i = 0; i < n(); ++i) u[i] = S(trial[i] + step_len * du[i]);
-                evaluate(phi_new, scale_new);
-                if (std::isfinite(phi_new) && phi_new <= phi + 1e-4 * step_len * slope) break;
-                // Round-off floor: near the minimum phi stops resolving changes.
-                if (std::isfinite(phi_new) && std::abs(phi_new - phi) <= 1e-14 * (std::abs(phi) + scale)) break;
-                if (ls == 40)
-                    throw StepFailure{"step " + std::to_string(step + 1) + ": line search failed", -1};
+                evaluate(phi_new, scale_new, mag_new);
+                if (std::isfinite(phi_new)) {
+                    const double decrease = -1e-4 * step_len * slope;
+                    if (decrease > 1e-10 * mag) {
+                        if (phi_new <= phi - decrease) break;
+                    } else if (norm(R) <= (1 - 1e-4 * step_len) * rn) {
+                        break;
+                    }
+                }
+                if (ls == 40) {
+                    for (std::size_t i = 0; i < n(); ++i) u[i] = S(trial[i]);
+                    evaluate(phi, scale, mag);  // back to the iterate (and its f, W)
+                    if (at_floor()) return;     // (b)
+                    if (below_resolution) {     // (c)
+                        stats.newton_round_off = true;
+                        return;
+                    }
+                    throw StepFailure{"step " + std::to_string(step + 1) +
+                                          ": line search failed: neither the potential nor the residual decreases "
+                                          "along the Newton direction (Newton iteration " + std::to_string(it + 1) +
+                                          ", relative residual " + sci(stats.residual) + ", directional slope " +
+                                          sci(slope) + ")",
+                                      -1};
+                }
                 step_len *= 0.5;
             }
             phi = phi_new;
             scale = scale_new;
+            mag = mag_new;
         }
     }
 
@@ -483,14 +757,26 @@ struct Simulator<S>::Impl {
             v_save = v;
         }
         try {
+            forces_current = false;
+            const bool guard = scene.solver.max_energy_growth > 0;
+            EnergySample start;
+            bool moved = false;
+            if (guard) {
+                moved = constraints_move(time + T);
+                start = energy_at_start();
+            }
             switch (scene.integrator) {
                 case Integrator::Explicit: explicit_step(T); break;
                 case Integrator::SemiImplicit: semi_implicit_step(T); break;
                 case Integrator::Implicit: implicit_step(T); break;
             }
             check_finite(step + 1);
+            // Implicit: Newton's last evaluation was at the new u. Else the
+            // force pass here is the one the next step starts with.
+            if (guard) check_energy(T, start, scene.integrator == Integrator::Implicit ? newton_W : forces(true), moved);
             time += T;
         } catch (const StepFailure& failure) {
+            forces_current = false;
             if (!may_retry) throw;
             u = u_save;
             v = v_save;

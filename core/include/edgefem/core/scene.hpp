@@ -48,6 +48,17 @@ struct SolverSettings {
     // StepStats::unconverged_solves. (A fixed CG budget,
     // cg_fixed_iterations, is a deliberate partial solve and never fails.)
     bool fail_on_unconverged = true;
+    // Energy guard for the dynamic integrators: a step fails (SimulationError,
+    // or a retry with max_step_halvings) when the total energy (kinetic +
+    // elastic + gravity) has risen above its lowest level, net of the
+    // external forces' work and of what mass damping removed, by more than
+    // (max_energy_growth - 1) x the largest kinetic + elastic energy seen: a
+    // body released at rest then never holds more than this factor of its
+    // energy. Not checked: steps that move a constrained vertex (their work
+    // is unknown); measured but never failed: semi-implicit steps with a
+    // fixed CG budget (StepStats::energy_growth). 0 disables it; otherwise
+    // >= 1. docs/scenes.md ("Solver settings") says why 1.5.
+    double max_energy_growth = 1.5;
 };
 
 // A vertex driven to a target position.

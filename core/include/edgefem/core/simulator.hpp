@@ -36,11 +36,16 @@ struct StepStats {
     double solve_ms = 0;      // linear solves
     int solver_iterations = 0;  // CG iterations (summed over Newton iterations)
     int newton_iterations = 0;  // Implicit / static
+    bool newton_round_off = false;  // Newton stopped at its round-off floor above newton_tolerance
     double residual = 0;        // final relative residual of the last solve
     bool negative_curvature = false;  // CG met p^T A p <= 0 (K indefinite)
     int unconverged_solves = 0;  // semi-implicit CG solves that stopped above their tolerance
     index_t inverted_tets = 0;  // at the end of the step
     int halvings = 0;           // step halvings used
+    // Energy guard (SolverSettings::max_energy_growth > 0): 1 + the energy
+    // gained without a source since its lowest level / the largest kinetic +
+    // elastic energy seen, after the step: the ratio the guard bounds.
+    double energy_growth = 0;
 };
 
 struct Energies {
@@ -79,8 +84,9 @@ public:
     index_t num_vertices() const;
 
     // Advances by scene().dt with the scene's integrator; throws
-    // SimulationError on non-finite state or a failed solve (after the
-    // allowed step halvings).
+    // SimulationError on non-finite state, a failed solve or energy grown
+    // without a source (SolverSettings::max_energy_growth), after the
+    // allowed step halvings.
     const StepStats& step();
     // Static equilibrium under gravity, external forces and the prescribed
     // targets (reached fully), by Newton with line search and automatic load
