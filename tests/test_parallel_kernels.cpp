@@ -6,10 +6,13 @@
 // with the FE stiffness from the tet-local form. Colourings: conflict-free.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 
 #include "edgefem/core/deformations.hpp"
+#include "edgefem/core/make_box.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_edge_kernels.hpp"
 #include "edgefem/parallel/parallel_tet_kernels.hpp"
@@ -224,6 +227,32 @@ TEST(ParallelEdgeKernels, OwnerPartsSpillAndStayDeterministic) {
             }
         }
     }
+}
+
+// Auto: owner on a numbering with locality (the generated box), gather on
+// a shuffled one; bitwise the result of the variant it picks.
+TEST(ParallelEdgeKernels, AutoPicksOwnerWithLocalityAndGatherWithout) {
+    const Mesh box = make_box(12, 8, 6);
+    Mesh shuffled = box;
+    const index_t nv = box.num_vertices();
+    std::vector<index_t> new_of_old(nv);
+    for (index_t v = 0; v < nv; ++v) new_of_old[v] = v;
+    std::mt19937 rng(7);
+    std::shuffle(new_of_old.begin(), new_of_old.end(), rng);
+    for (index_t v = 0; v < nv; ++v)
+        for (int r = 0; r < 3; ++r) shuffled.X[3 * std::size_t(new_of_old[v]) + r] = box.X[3 * std::size_t(v) + r];
+    for (auto& t : shuffled.tets) t = new_of_old[t];
+    for (const auto& [mesh, expected] : {std::pair<const Mesh*, Variant>{&box, Variant::Owner}, std::pair<const Mesh*, Variant>{&shuffled, Variant::Gather}}) {
+        const auto models = edgefem::test::make_models<double>(*mesh);
+        const auto u = deformation_displacement(*mesh, Deformation::Twist);
+        const auto x = deformation_displacement(*mesh, Deformation::Random);
+        const auto ex = make_executor(Backend::OpenMP, 2);
+        const ParallelEdgeKernels<double> k(models.edge, ex, Variant::Auto);
+        EXPECT_EQ(k.variant(), expected);
+        expect_bitwise(run_parallel<ModelKind::FE>(models.edge, ex, Variant::Auto, u, x),
+                       run_parallel<ModelKind::FE>(models.edge, ex, expected, u, x), to_string(expected));
+    }
+    EXPECT_EQ(parse_variant("auto"), Variant::Auto);
 }
 
 TEST(ForwardSpill, WindowsAndConsumers) {

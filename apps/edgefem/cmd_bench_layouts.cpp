@@ -89,7 +89,7 @@ struct Options {
     std::vector<std::string> layouts;    // empty: all
     std::vector<std::string> backends = {"serial"};
     std::vector<int> threads = {0};
-    std::string variant = "gather";
+    std::string variant = "auto";
     std::string precision = "double";
     double seconds = 0.5;
     bool quick = false;
@@ -542,7 +542,7 @@ void add_bench_layouts_command(CLI::App& app) {
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
     cmd->add_option("--variant", opts->variant, "Parallel variant of omp/tbb rows (see `edgefem bench --help`)")
-        ->check(CLI::IsMember({"colour", "color", "gather", "atomic", "private", "owner"}))
+        ->check(CLI::IsMember({"auto", "colour", "color", "gather", "atomic", "private", "owner"}))
         ->capture_default_str();
     cmd->add_option("--precision", opts->precision, "Scalar type of the tet-local and tsep-list rows")
         ->check(CLI::IsMember({"double", "float"}))

@@ -128,11 +128,12 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
         ->capture_default_str();
     if (with_variant)
         cmd.add_option("--variant", opts.variant,
-                       "How concurrent writes are resolved: colour (coloured scatter, deterministic), gather "
+                       "How concurrent writes are resolved: auto (owner when the vertex numbering has "
+                       "locality, else gather), colour (coloured scatter, deterministic), gather "
                        "(pull through adjacency lists, deterministic), atomic (atomic adds), private "
                        "(per-thread accumulators + reduction) or owner (fixed parts of consecutive items, "
                        "writes past a part spilled and added in part order, deterministic)")
-            ->check(CLI::IsMember({"colour", "color", "gather", "atomic", "private", "owner"}))
+            ->check(CLI::IsMember({"auto", "colour", "color", "gather", "atomic", "private", "owner"}))
             ->each([&opts](const std::string&) { opts.variant_given = true; })
             ->capture_default_str();
 }

@@ -84,7 +84,7 @@ void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required
 struct ExecOptions {
     std::string backend = "serial";  // serial | omp | tbb
     int threads = 0;                 // 0: all hardware threads
-    std::string variant = "gather";  // colour | gather | atomic | private (docs/parallel.md: gather is fastest here)
+    std::string variant = "auto";  // auto | colour | gather | atomic | private | owner (docs/parallel.md)
     bool variant_given = false;      // --variant on the command line
 
     // The parallel kernels run unless this is the plain serial default

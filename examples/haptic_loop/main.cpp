@@ -57,7 +57,7 @@ struct Options {
     bool async_tangent = false;  // build K on a background thread, swap it in when ready
     std::string backend = "serial";
     int threads = 0;
-    std::string variant = "gather";
+    std::string variant = "auto";
     std::string ordering = "rcm";
     double force = 0.2;  // N, spread over the probed vertices
     int probe_vertices = 6;
@@ -72,7 +72,7 @@ struct Options {
     std::fprintf(stderr,
                  "edgefem_haptic_loop: %s\nusage: edgefem_haptic_loop [--mesh PATH|box:NXxNYxNZ] [--seconds S] "
                  "[--rate HZ] [--cg-iters N] [--stiffness-interval N] [--async-tangent] [--precision double|float] [--model fe|sn] "
-                 "[--backend serial|omp|tbb] [--threads N] [--variant colour|gather|atomic|private|owner] [--ordering input|rcm] [--force N] [--young PA] [--alpha 1/S] [--indefinite] [--free-run] [--gravity G]\n",
+                 "[--backend serial|omp|tbb] [--threads N] [--variant auto|colour|gather|atomic|private|owner] [--ordering input|rcm] [--force N] [--young PA] [--alpha 1/S] [--indefinite] [--free-run] [--gravity G]\n",
                  msg);
     std::exit(2);
 }

@@ -14,8 +14,9 @@ Variant parse_variant(std::string_view name) {
     if (name == "atomic") return Variant::Atomic;
     if (name == "private") return Variant::Private;
     if (name == "owner") return Variant::Owner;
+    if (name == "auto") return Variant::Auto;
     throw InvalidArgument("unknown variant '" + std::string(name) +
-                          "' (expected colour, gather, atomic, private or owner)");
+                          "' (expected auto, colour, gather, atomic, private or owner)");
 }
 
 const char* to_string(Variant v) {
@@ -24,6 +25,7 @@ const char* to_string(Variant v) {
         case Variant::Gather: return "gather";
         case Variant::Atomic: return "atomic";
         case Variant::Owner: return "owner";
+        case Variant::Auto: return "auto";
         default: return "private";
     }
 }

@@ -260,7 +260,10 @@ PYBIND11_MODULE(edgefem, m) {
         .def_readwrite("newton_tolerance", &SolverSettings::newton_tolerance)
         .def_readwrite("newton_max_iterations", &SolverSettings::newton_max_iterations)
         .def_readwrite("load_steps", &SolverSettings::load_steps)
-        .def_readwrite("max_step_halvings", &SolverSettings::max_step_halvings);
+        .def_readwrite("max_step_halvings", &SolverSettings::max_step_halvings)
+        .def_readwrite("stiffness_interval", &SolverSettings::stiffness_interval)
+        .def_readwrite("fail_on_unconverged", &SolverSettings::fail_on_unconverged)
+        .def_readwrite("max_energy_growth", &SolverSettings::max_energy_growth);
 
     py::class_<Scene>(m, "Scene", "Mesh, material, loads, constraints and integrator settings (docs/scenes.md).")
         .def(py::init([](Mesh mesh, const Material& material, std::vector<index_t> fixed,
@@ -330,6 +333,9 @@ PYBIND11_MODULE(edgefem, m) {
         .def_readonly("negative_curvature", &StepStats::negative_curvature)
         .def_readonly("inverted_tets", &StepStats::inverted_tets)
         .def_readonly("halvings", &StepStats::halvings)
+        .def_readonly("unconverged_solves", &StepStats::unconverged_solves)
+        .def_readonly("newton_round_off", &StepStats::newton_round_off)
+        .def_readonly("energy_growth", &StepStats::energy_growth)
         .def("__repr__", [](const StepStats& s) {
             return "<edgefem.StepStats iterations=" + std::to_string(s.solver_iterations) +
                    " residual=" + std::to_string(s.residual) + ">";

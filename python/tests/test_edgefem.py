@@ -179,6 +179,27 @@ def test_explicit_blow_up_raises_simulation_error():
         sim.run(200)
 
 
+def test_energy_guard_setting_and_stats():
+    # The guard stops an unstable explicit run with a message that names it,
+    # and lets a normal semi-implicit run through while reporting its ratio.
+    scene = clamped_box_scene(4, 2, 2)
+    assert scene.solver.max_energy_growth == 1.5 and scene.solver.fail_on_unconverged
+    scene.integrator = edgefem.Integrator.Explicit
+    scene.material = edgefem.Material(1e9, 0.3, 1000)
+    scene.dt = 1e-2
+    with pytest.raises(edgefem.SimulationError, match="(?i)energy"):
+        edgefem.Simulator(scene).run(200)
+    ok = clamped_box_scene(4, 2, 2)
+    ok.solver.stiffness_interval = 2
+    sim = edgefem.Simulator(ok)
+    stats = sim.run(10)
+    assert 1.0 <= stats.energy_growth < ok.solver.max_energy_growth
+    assert stats.unconverged_solves == 0 and not stats.newton_round_off
+    ok.solver.max_energy_growth = 0.5  # neither 0 (off) nor >= 1
+    with pytest.raises(edgefem.InvalidArgument, match="max_energy_growth"):
+        edgefem.Simulator(ok)
+
+
 def test_vtu_series(tmp_path):
     mesh = small_box()
     u = edgefem.deformation(mesh, "twist", 0.1)

@@ -41,6 +41,7 @@ public:
 
     const EdgeModel<S>& model() const { return m_; }
     const Executor& executor() const { return *ex_; }
+    // The variant that runs: Auto is resolved when the plan is built.
     Variant variant() const { return variant_; }
 
     // K blocks: #E, then the sink block(s) (one per chunk of the coloured
@@ -98,6 +99,14 @@ private:
     // Incoming stiffness contributions per edge (the one-pass TSEP-list
     // stiffness of the gather and owner variants).
     void build_stiffness_sources();
+    // The owner variant's vertex-segment parts (balanced on edges).
+    static ForwardSpill vertex_spill(const EdgeModel<S>& m, index_t parts) {
+        return make_forward_spill(m.num_vertices, balanced_parts(m.edge_first, parts), [&m](index_t a) {
+            index_t t = a;
+            for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) t = std::max(t, m.edge[e][1]);
+            return t;
+        });
+    }
 
     EdgeModel<S> m_;
     std::shared_ptr<const Executor> ex_;
@@ -144,6 +153,15 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
       parts_(std::max(1, ex_->threads())),
       form_(std::move(form)) {
     const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    if (variant_ == Variant::Auto) {
+        // Owner wins every kernel at 1 and 2 threads when the numbering has
+        // locality (docs/parallel.md); without it (TetGen's input order on
+        // large meshes) its spill windows outgrow the work and gather, which
+        // does not depend on the numbering, is the safe choice. The test is
+        // a function of the mesh only, so results stay thread-count free.
+        const ForwardSpill probe = vertex_spill(m_, opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv));
+        variant_ = probe.spill_targets() <= std::size_t(nv) ? Variant::Owner : Variant::Gather;
+    }
     if (form_.num_tets > 0) {
         if (form_.num_edges != ne) throw InvalidArgument("tet-local form and edge model belong to different meshes");
         m_.target = {};  // the TSEP-list stiffness plan is not needed
@@ -208,11 +226,7 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
         case Variant::Owner: {
             const index_t P = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv);
             const auto& m = m_;
-            vspill_ = make_forward_spill(nv, balanced_parts(m.edge_first, P), [&m](index_t a) {
-                index_t t = a;
-                for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) t = std::max(t, m.edge[e][1]);
-                return t;
-            });
+            vspill_ = vertex_spill(m, P);
             espill_ = make_forward_spill(ne, balanced_parts(m.tsep_first, P), [&m](index_t e0) {
                 index_t t = e0;
                 for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) t = std::max(t, m.tsep_other[P]);

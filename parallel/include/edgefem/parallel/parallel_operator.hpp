@@ -20,14 +20,14 @@
 namespace edgefem {
 
 template <class S>
-OperatorFactory<S> parallel_operator_factory(std::shared_ptr<const Executor> executor, Variant variant = Variant::Gather,
+OperatorFactory<S> parallel_operator_factory(std::shared_ptr<const Executor> executor, Variant variant = Variant::Auto,
                                              PlanOptions opts = {});
 
 // Direct construction (what the factory calls).
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_parallel_operator(const Mesh& mesh, const Materials& materials, ModelKind model,
                                                            Method method, std::shared_ptr<const Executor> executor,
-                                                           Variant variant = Variant::Gather,
+                                                           Variant variant = Variant::Auto,
                                                            const PlanOptions& opts = {});
 
 // Tets with non-positive deformed volume, counted on the executor (blocked,
