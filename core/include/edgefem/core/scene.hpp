@@ -57,8 +57,8 @@ struct SolverSettings {
     // energy. Not checked: steps that move a constrained vertex (their work
     // is unknown); measured but never failed: semi-implicit steps with a
     // fixed CG budget (StepStats::energy_growth). 0 disables it; otherwise
-    // >= 1. docs/scenes.md ("Solver settings") says why 1.5.
-    double max_energy_growth = 1.5;
+    // >= 1. docs/scenes.md ("Solver settings") says why 10.
+    double max_energy_growth = 10;
 };
 
 // A vertex driven to a target position.

@@ -6,8 +6,7 @@
 // mass-proportional damping alpha = 10 /s, no gravity, the library's default
 // solver settings except solver.max_step_halvings = 3, so the rest shape
 // is the only equilibrium it should return to. The defaults include the
-// simulator's energy guard (solver.max_energy_growth = 1.5, below
-// kEnergyGrowthFactor): a step that makes the energy grow without a source
+// simulator's energy guard (solver.max_energy_growth = 10): a step that makes the energy grow without a source
 // fails and is retried as halves, so an energy-injecting step (semi-implicit
 // on 0.1-degree slivers, or at Y = 1e9) is caught where it happens instead
 // of running on as silent garbage; where halving does not help, the run
