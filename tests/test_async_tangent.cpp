@@ -10,24 +10,16 @@
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/async_tangent.hpp"
+#include "cantilever.hpp"
 
 using namespace edgefem;
 
 namespace {
 
-// A soft cantilever clamped at x = min under gravity -z, lightly damped.
+// The tests' cantilever (test_support/cantilever.hpp), lightly damped.
 Scene cantilever() {
-    Scene s;
-    s.mesh = make_box(8, 2, 2);
-    s.materials = Material{2e4, 0.3, 1000};
-    s.gravity = {0, 0, -9.81};
-    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
-        if (s.mesh.X[3 * v] < -0.04 + 1e-9) s.fixed.push_back(v);
-    s.integrator = Integrator::SemiImplicit;
-    s.dt = 1e-3;
+    Scene s = test::cantilever_scene();
     s.rayleigh_alpha = 20;
-    s.solver.cg_tolerance = 1e-10;
-    s.solver.cg_max_iterations = 2000;
     return s;
 }
 

@@ -10,25 +10,14 @@
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
+#include "cantilever.hpp"
+#include "forwarding_operator.hpp"
 
 using namespace edgefem;
 
 namespace {
 
-// A soft cantilever: 8 x 2 x 2 cubes of 1 cm, clamped at x = min, gravity -z.
-Scene cantilever(Integrator integrator, double dt) {
-    Scene s;
-    s.mesh = make_box(8, 2, 2);
-    s.materials = Material{2e4, 0.3, 1000};
-    s.gravity = {0, 0, -9.81};
-    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
-        if (s.mesh.X[3 * v] < -0.04 + 1e-9) s.fixed.push_back(v);
-    s.integrator = integrator;
-    s.dt = dt;
-    s.solver.cg_tolerance = 1e-10;
-    s.solver.cg_max_iterations = 2000;
-    return s;
-}
+Scene cantilever(Integrator integrator, double dt) { return test::cantilever_scene(integrator, dt); }
 
 double total_mass(const Simulator<double>& sim) {
     double m = 0;
@@ -289,25 +278,16 @@ TEST(Simulator, FloatTracksDoubleAndSceneErrorsNameTheField) {
 namespace {
 
 // Core's operator, counting build_stiffness calls.
-class CountingOperator final : public ElasticOperator<double> {
+class CountingOperator final : public test::ForwardingOperator {
 public:
-    CountingOperator(std::unique_ptr<ElasticOperator<double>> op, int& builds) : op_(std::move(op)), builds_(builds) {}
-    index_t num_vertices() const override { return op_->num_vertices(); }
-    double forces(const double* u, double* f, bool energy) override { return op_->forces(u, f, energy); }
-    double energy(const double* u) override { return op_->energy(u); }
+    CountingOperator(std::unique_ptr<ElasticOperator<double>> op, int& builds)
+        : ForwardingOperator(std::move(op)), builds_(builds) {}
     void build_stiffness(bool definite) override {
         ++builds_;
         op_->build_stiffness(definite);
     }
-    void multiply(const double* x, double* y) const override { op_->multiply(x, y); }
-    void diagonal_blocks(double* D) const override { op_->diagonal_blocks(D); }
-    void for_each_block(void (*visit)(void*, index_t, index_t, const double*), void* ctx) const override {
-        op_->for_each_block(visit, ctx);
-    }
-    index_t inverted_tets(const double* u) const override { return op_->inverted_tets(u); }
 
 private:
-    std::unique_ptr<ElasticOperator<double>> op_;
     int& builds_;
 };
 
@@ -501,10 +481,10 @@ namespace {
 // Core's operator with deterministic noise of relative size `jitter` (of
 // the forces' rms) added to every force evaluation: a residual floor, as
 // round-off makes one on stiff or badly shaped meshes.
-class JitterOperator final : public ElasticOperator<double> {
+class JitterOperator final : public test::ForwardingOperator {
 public:
-    JitterOperator(std::unique_ptr<ElasticOperator<double>> op, double jitter) : op_(std::move(op)), jitter_(jitter) {}
-    index_t num_vertices() const override { return op_->num_vertices(); }
+    JitterOperator(std::unique_ptr<ElasticOperator<double>> op, double jitter)
+        : ForwardingOperator(std::move(op)), jitter_(jitter) {}
     double forces(const double* u, double* f, bool energy) override {
         const double W = op_->forces(u, f, energy);
         const std::size_t n = 3 * std::size_t(num_vertices());
@@ -518,17 +498,8 @@ public:
         }
         return W;
     }
-    double energy(const double* u) override { return op_->energy(u); }
-    void build_stiffness(bool definite) override { op_->build_stiffness(definite); }
-    void multiply(const double* x, double* y) const override { op_->multiply(x, y); }
-    void diagonal_blocks(double* D) const override { op_->diagonal_blocks(D); }
-    void for_each_block(void (*visit)(void*, index_t, index_t, const double*), void* ctx) const override {
-        op_->for_each_block(visit, ctx);
-    }
-    index_t inverted_tets(const double* u) const override { return op_->inverted_tets(u); }
 
 private:
-    std::unique_ptr<ElasticOperator<double>> op_;
     double jitter_;
     long calls_ = 0;
 };

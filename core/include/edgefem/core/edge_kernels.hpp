@@ -144,6 +144,20 @@ inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, 
     }
 }
 
+// One edge of a segment scatter: p~ g added to V0's sums, subtracted from
+// f(V1) at fb. Shared by edge_force_segment and the fused
+// tsep_force_segment, which must stay bitwise equal.
+template <class S>
+inline void edge_force_terms(const S* __restrict p, index_t e, S gs, S& acc0, S& acc1, S& acc2, S* fb) {
+    const S v0 = p[3 * std::size_t(e)] * gs, v1 = p[3 * std::size_t(e) + 1] * gs, v2 = p[3 * std::size_t(e) + 2] * gs;
+    acc0 += v0;
+    acc1 += v1;
+    acc2 += v2;
+    fb[0] -= v0;
+    fb[1] -= v1;
+    fb[2] -= v2;
+}
+
 // Edge scatter over the segment of edges whose V0 is `a`: f(a) gets the
 // segment's sum from registers (edges are sorted by V0, so a per-edge
 // f(V0) += ... would chain stores to one address); each f(V1) -= p~ g.
@@ -152,17 +166,7 @@ inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
                                S* __restrict f, const ForwardOut<S>& out) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
     for_segment<3>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, out,
-                   [&](index_t e, S* fb) {
-                       const S ge = S(g[e]);
-                       const S v0 = p[3 * std::size_t(e)] * ge, v1 = p[3 * std::size_t(e) + 1] * ge,
-                               v2 = p[3 * std::size_t(e) + 2] * ge;
-                       acc0 += v0;
-                       acc1 += v1;
-                       acc2 += v2;
-                       fb[0] -= v0;
-                       fb[1] -= v1;
-                       fb[2] -= v2;
-                   });
+                   [&](index_t e, S* fb) { edge_force_terms(p, e, S(g[e]), acc0, acc1, acc2, fb); });
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
     f[3 * std::size_t(a) + 2] += acc2;
@@ -204,15 +208,7 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
         }
         const double ge = g[e] + s;
         g[e] = ge;
-        S* fb = f + 3 * std::size_t(m.edge[e][1]);
-        const S gs = S(ge);
-        const S v0 = p[3 * std::size_t(e)] * gs, v1 = p[3 * std::size_t(e) + 1] * gs, v2 = p[3 * std::size_t(e) + 2] * gs;
-        acc0 += v0;
-        acc1 += v1;
-        acc2 += v2;
-        fb[0] -= v0;
-        fb[1] -= v1;
-        fb[2] -= v2;
+        edge_force_terms(p, e, S(ge), acc0, acc1, acc2, f + 3 * std::size_t(m.edge[e][1]));
     }
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
