@@ -54,7 +54,14 @@ struct Options {
     std::string precision = "double";
     std::string model = "fe";
     int stiffness_interval = 1;  // build K every N steps (a lagged tangent)
-    bool async_tangent = false;  // build K on a background thread, swap it in when ready
+    // Build K on a background thread (the second core), swap it in when
+    // ready: the default where the parallel module is built, because only
+    // then does the FE loop keep up (examples/haptic_loop/README.md).
+#ifdef EDGEFEM_HAPTIC_HAVE_PARALLEL
+    bool async_tangent = true;
+#else
+    bool async_tangent = false;
+#endif
     std::string backend = "serial";
     int threads = 0;
     std::string variant = "auto";
@@ -72,7 +79,7 @@ struct Options {
 [[noreturn]] void usage(const char* msg) {
     std::fprintf(stderr,
                  "edgefem_haptic_loop: %s\nusage: edgefem_haptic_loop [--mesh PATH|box:NXxNYxNZ] [--seconds S] "
-                 "[--rate HZ] [--cg-iters N] [--stiffness-interval N] [--async-tangent] [--precision double|float] [--model fe|sn] "
+                 "[--rate HZ] [--cg-iters N] [--stiffness-interval N] [--async-tangent|--sync-tangent] [--precision double|float] [--model fe|sn] "
                  "[--backend serial|omp|tbb] [--threads N] [--variant auto|colour|gather|atomic|private|owner] [--ordering input|rcm] [--spin-us US] [--force N] [--young PA] [--alpha 1/S] [--indefinite] [--free-run] [--gravity G]\n",
                  msg);
     std::exit(2);
@@ -94,6 +101,7 @@ Options parse(int argc, char** argv) {
         else if (a == "--model") o.model = next();
         else if (a == "--stiffness-interval") o.stiffness_interval = std::atoi(next().c_str());
         else if (a == "--async-tangent") o.async_tangent = true;
+        else if (a == "--sync-tangent") o.async_tangent = false;
         else if (a == "--backend") o.backend = next();
         else if (a == "--threads") o.threads = std::atoi(next().c_str());
         else if (a == "--variant") o.variant = next();
