@@ -10,9 +10,9 @@
 // force | stiffness | force+stiffness | step; method edge-fe | edge-sn | tet.
 // 1 thread runs core's serial loops (make_elastic_operator, the serial
 // Simulator); more threads run parallel/'s operators (OpenMP executor, the
-// gather variant: deterministic, and the fastest at 2 threads in
-// bench_parallel; the per-tet operator runs coloured) and the Simulator on
-// the same executor.
+// default variant Auto: owner when the mesh's numbering has locality, else
+// gather, both deterministic; the per-tet operator runs coloured) and the
+// Simulator on the same executor. The meshes keep their input numbering.
 //
 // Kernels run on the twist configuration (edgefem/core/deformations.hpp),
 // Y = 1e5 Pa, nu = 0.3. The step: h = 1 ms, gravity -z, the lowest 1% of
@@ -125,8 +125,7 @@ std::shared_ptr<const Executor> executor_for(int threads) {
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_op(const Mesh& mesh, Which m, int threads) {
     if (threads == 1) return make_elastic_operator<S>(mesh, materials(), model_of(m), method_of(m));
-    return make_parallel_operator<S>(mesh, materials(), model_of(m), method_of(m), executor_for(threads),
-                                     Variant::Gather);
+    return make_parallel_operator<S>(mesh, materials(), model_of(m), method_of(m), executor_for(threads));
 }
 
 Scene step_scene(const Mesh& mesh, Which m) {
@@ -147,7 +146,7 @@ void BM_Paper(benchmark::State& state, std::string mesh_name, Kernel k, Which m,
             sim = std::make_unique<Simulator<S>>(std::move(s));
         } else {
             auto ex = executor_for(threads);
-            sim = std::make_unique<Simulator<S>>(std::move(s), ex, parallel_operator_factory<S>(ex, Variant::Gather));
+            sim = std::make_unique<Simulator<S>>(std::move(s), ex, parallel_operator_factory<S>(ex));
         }
         for (int i = 0; i < 3; ++i) sim->step();  // warm: K, buffers, a moving state
         for (auto _ : state) sim->step();
