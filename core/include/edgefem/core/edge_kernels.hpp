@@ -76,18 +76,22 @@ template <class T>
 inline ForwardOut<T> direct_only(T* out) {
     return {out, nullptr, std::numeric_limits<index_t>::max()};
 }
+// The first item of [first, last) whose target goes to the spill buffer
+// (last when none). Targets ascend, so only a segment whose last target
+// spills needs the scan; the serial loops' direct_only(out) folds the test
+// away. Found before the loops so that the main loop has no test in it (a
+// test inside measured 25-30 % slower in the latency-bound TSEP loop).
+template <class T, class Target>
+inline index_t spill_start(index_t first, index_t last, Target&& target, const ForwardOut<T>& out) {
+    if (out.end == std::numeric_limits<index_t>::max() || last == first || target(last - 1) < out.end) return last;
+    index_t mid = first;
+    while (target(mid) < out.end) ++mid;
+    return mid;
+}
 // body(i, row of target(i)) for i in [first, last), W values per target.
-// The split point is found first, so that the main loop has no test in it
-// (a test inside measured 25-30 % slower in the latency-bound TSEP loop).
 template <int W, class T, class Target, class Body>
 inline void for_segment(index_t first, index_t last, Target&& target, const ForwardOut<T>& out, Body&& body) {
-    // Targets ascend: only a segment whose last target spills needs the scan
-    // (the serial loops' direct_only(out) folds the test away).
-    index_t mid = last;
-    if (out.end < std::numeric_limits<index_t>::max() && last > first && target(last - 1) >= out.end) {
-        mid = first;
-        while (target(mid) < out.end) ++mid;
-    }
+    const index_t mid = spill_start(first, last, target, out);
     for (index_t i = first; i < mid; ++i) body(i, out.direct + W * std::size_t(target(i)));
     for (index_t i = mid; i < last; ++i) body(i, out.spill + W * std::size_t(target(i) - out.end));
 }
@@ -103,13 +107,7 @@ inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __re
     // test inside it (or the lambda form) it measured 25-30 % slower
     // (bench_kernels force/edge-fe-3pass, bunny-4k: 94 vs 73 us).
     const index_t first = m.tsep_first[e0], last = m.tsep_first[e0 + 1];
-    // E1 ascend: only a segment whose last E1 spills needs the scan (the
-    // serial loops' direct_only(out) folds the test away).
-    index_t mid = last;
-    if (out.end < std::numeric_limits<index_t>::max() && last > first && m.tsep_other[last - 1] >= out.end) {
-        mid = first;
-        while (m.tsep_other[mid] < out.end) ++mid;
-    }
+    const index_t mid = spill_start(first, last, [&m](index_t P) { return m.tsep_other[P]; }, out);
     const double z0 = zeta[e0];
     double acc = 0;
     double* __restrict direct = out.direct;

@@ -153,14 +153,16 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
       parts_(std::max(1, ex_->threads())),
       form_(std::move(form)) {
     const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    const index_t owner_parts = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv);
     if (variant_ == Variant::Auto) {
         // Owner wins every kernel at 1 and 2 threads when the numbering has
         // locality (docs/parallel.md); without it (TetGen's input order on
         // large meshes) its spill windows outgrow the work and gather, which
         // does not depend on the numbering, is the safe choice. The test is
         // a function of the mesh only, so results stay thread-count free.
-        const ForwardSpill probe = vertex_spill(m_, opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv));
-        variant_ = probe.spill_targets() <= std::size_t(nv) ? Variant::Owner : Variant::Gather;
+        vspill_ = vertex_spill(m_, owner_parts);  // kept when owner is chosen
+        variant_ = vspill_.spill_targets() <= std::size_t(nv) ? Variant::Owner : Variant::Gather;
+        if (variant_ == Variant::Gather) vspill_ = {};
     }
     if (form_.num_tets > 0) {
         if (form_.num_edges != ne) throw InvalidArgument("tet-local form and edge model belong to different meshes");
@@ -224,10 +226,9 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
             break;
         }
         case Variant::Owner: {
-            const index_t P = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv);
             const auto& m = m_;
-            vspill_ = vertex_spill(m, P);
-            espill_ = make_forward_spill(ne, balanced_parts(m.tsep_first, P), [&m](index_t e0) {
+            if (vspill_.parts() == 0) vspill_ = vertex_spill(m, owner_parts);  // Auto has built it already
+            espill_ = make_forward_spill(ne, balanced_parts(m.tsep_first, owner_parts), [&m](index_t e0) {
                 index_t t = e0;
                 for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) t = std::max(t, m.tsep_other[P]);
                 return t;
