@@ -1,9 +1,13 @@
 // Parallel back-ends: force, stiffness and K x of the edge-based FE model
-// (double, twist configuration) for back-end x variant x threads, plus a
-// STREAM-like triad for the memory bandwidth of the same run.
+// (double, twist configuration) and a whole semi-implicit step, for
+// back-end x variant x threads, plus a STREAM-like triad for the memory
+// bandwidth of the same run. Threads: 1, 2, 4, ... up to the cores present
+// (and that count itself); $EDGEFEM_BENCH_THREADS="1,3,16" overrides.
 // Names: <kernel>/<backend>/<variant>/<threads>/<mesh>; "serial/core" is
-// core's serial loops (the reference). Counters: per_tet (s per tet, shown
-// as ns), bytes (compulsory bytes moved per call, force kernel only) and
+// core's serial loops (the reference). The step (kernel "step") is
+// bench_step's scene: h = 1 ms, gravity, the lowest 1% fixed, 20
+// warm-started CG iterations; "step/serial/core" is the serial Simulator.
+// Counters: per_tet (s per tet, shown as ns), bytes (compulsory bytes moved per call, force kernel only) and
 // bytes_per_second; times are wall-clock (UseRealTime). Every mesh is
 // renumbered by reverse Cuthill-McKee first (partition/), the locality
 // ordering the blocked colourings and the owner variant's parts rely on
@@ -18,14 +22,18 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
+#include <sstream>
 
 #include "bench_meshes.hpp"
+#include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/edge_kernels.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
 #include "edgefem/parallel/parallel_edge_kernels.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
@@ -39,6 +47,7 @@ const char* name_of(Kernel k) { return k == Kernel::Force ? "force" : k == Kerne
 
 struct Prepared {
     std::string name;
+    Mesh mesh;  // RCM-renumbered
     EdgeModel<double> model;
     TetEdgeForm<double> form;
     std::vector<double> u, x;
@@ -49,10 +58,11 @@ Prepared& prepared(const std::string& name) {
     static std::unique_ptr<Prepared> p;
     if (!p || p->name != name) {
         p.reset();
-        const Mesh mesh = permute_mesh(bench::bench_mesh(name), vertex_ordering(bench::bench_mesh(name), Ordering::RCM));
-        const Topology topo = build_topology(mesh);
         p = std::make_unique<Prepared>();
         p->name = name;
+        p->mesh = permute_mesh(bench::bench_mesh(name), vertex_ordering(bench::bench_mesh(name), Ordering::RCM));
+        const Mesh& mesh = p->mesh;
+        const Topology topo = build_topology(mesh);
         const Materials mat(Material{1e5, 0.3, 1000});
         p->model = make_edge_model<double>(topo, compute_coefficients(mesh, topo, mat));
         p->form = make_tet_edge_form<double>(mesh, topo, mat);
@@ -76,6 +86,14 @@ double force_bytes(const EdgeModel<double>& m) {
     return pass1 + pass2 + pass3;
 }
 
+// $EDGEFEM_OWNER_PARTS: the owner variant's part count (default: a
+// function of #V, variant.hpp), for studies of its balance at many threads.
+PlanOptions plan_options() {
+    PlanOptions o;
+    if (const char* env = std::getenv("EDGEFEM_OWNER_PARTS"); env && *env) o.owner_parts = std::max(0, std::atoi(env));
+    return o;
+}
+
 // The kernels object of the current (mesh, backend, variant, threads),
 // kept while consecutive benchmarks use it.
 struct Current {
@@ -90,7 +108,7 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant
         cur.k.reset();
         const auto t0 = std::chrono::steady_clock::now();
         cur.k = std::make_unique<ParallelEdgeKernels<double>>(prepared(mesh).model, make_executor(b, threads), v,
-                                                              PlanOptions{}, prepared(mesh).form);
+                                                              plan_options(), prepared(mesh).form);
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (v == Variant::Colour && b == Backend::OpenMP && threads == 1)
             std::fprintf(stderr, "%s colourings (plan %.2f s): vertex segments %s; tsep g %s; tsep K %s\n", mesh.c_str(), s,
@@ -159,6 +177,53 @@ void BM_Parallel(benchmark::State& state, std::string mesh, Kernel k, Backend b,
     set_counters(state, p, k);
 }
 
+// One semi-implicit step (bench_step's scene, 20 warm-started CG
+// iterations) on the RCM mesh: serial Simulator when `threads` is 0, else
+// the Simulator on the back-end's executor with the variant's operator.
+void BM_Step(benchmark::State& state, std::string mesh, Backend b, Variant v, int threads) {
+    // Kept while consecutive runs (repetitions) use it: bunny-1m's set-up
+    // takes seconds.
+    static std::string key;
+    static std::unique_ptr<Simulator<double>> sim;
+    const std::string k = mesh + to_string(b) + to_string(v) + std::to_string(threads);
+    if (key != k || !sim) {
+        sim.reset();
+        Scene scene = step_benchmark_scene(prepared(mesh).mesh, Material{1e5, 0.3, 1000});
+        scene.solver.cg_fixed_iterations = 20;
+        std::shared_ptr<const Executor> ex;
+        OperatorFactory<double> factory;
+        if (threads > 0) {
+            ex = make_executor(b, threads);
+            factory = parallel_operator_factory<double>(ex, v, plan_options());
+        }
+        sim = std::make_unique<Simulator<double>>(std::move(scene), ex, factory);
+        for (int i = 0; i < 3; ++i) sim->step();  // warm: K, buffers, a moving state
+        key = k;
+    }
+    for (auto _ : state) sim->step();
+    state.counters["per_tet"] = benchmark::Counter(double(prepared(mesh).model.num_tets),
+                                                   benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// 1, 2, 4, ... below the cores present, then that count; or the list in
+// $EDGEFEM_BENCH_THREADS.
+std::vector<int> thread_counts() {
+    std::vector<int> out;
+    if (const char* env = std::getenv("EDGEFEM_BENCH_THREADS"); env && *env) {
+        std::stringstream ss(env);
+        std::string item;
+        while (std::getline(ss, item, ','))
+            if (const int t = std::atoi(item.c_str()); t > 0) out.push_back(t);
+        if (!out.empty()) return out;
+        std::fprintf(stderr, "EDGEFEM_BENCH_THREADS=%s names no thread count; using the default\n", env);
+    }
+    const int cores = std::max(1, hardware_threads());
+    for (int t = 1; t < cores; t *= 2) out.push_back(t);
+    out.push_back(cores);
+    if (out.size() == 1) out.push_back(2);  // one core: still show 2 threads
+    return out;
+}
+
 // STREAM triad a = b + s c on arrays far larger than the caches, in the
 // executor's fixed blocks; 24 bytes per element (no write-allocate counted,
 // as STREAM does).
@@ -166,10 +231,11 @@ void BM_Triad(benchmark::State& state, int threads) {
     const std::size_t n = std::size_t(1) << 24;  // 3 x 128 MiB
     static std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
     const auto ex = make_executor(threads == 1 ? Backend::Serial : Backend::OpenMP, threads, Schedule::Static);
-    const std::size_t chunk = (n + 63) / 64;
+    const index_t chunks = 64 * std::max(1, threads);
+    const std::size_t chunk = (n + chunks - 1) / chunks;
     const double s = 3.0;
     for (auto _ : state) {
-        ex->for_chunks(64, [&](index_t k) {
+        ex->for_chunks(chunks, [&](index_t k) {
             const std::size_t lo = std::size_t(k) * chunk, hi = std::min(n, lo + chunk);
             double* __restrict pa = a.data();
             const double* __restrict pb = b.data();
@@ -186,7 +252,8 @@ void BM_Triad(benchmark::State& state, int threads) {
 
 int main(int argc, char** argv) {
     benchmark::Initialize(&argc, argv);
-    for (int t : {1, 2})
+    const std::vector<int> threads = thread_counts();
+    for (int t : threads)
         benchmark::RegisterBenchmark(("triad/" + std::to_string(t)).c_str(), BM_Triad, t)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
@@ -196,9 +263,13 @@ int main(int argc, char** argv) {
                                          std::string(mesh), k)
                 ->Unit(benchmark::kMicrosecond)
                 ->UseRealTime();
+        benchmark::RegisterBenchmark((std::string("step/serial/core/1/") + mesh).c_str(), BM_Step, std::string(mesh),
+                                     Backend::Serial, Variant::Auto, 0)
+            ->Unit(benchmark::kMicrosecond)
+            ->UseRealTime();
         for (Backend b : {Backend::OpenMP, Backend::TBB})
             for (Variant v : kAllVariants)
-                for (int t : {1, 2})
+                for (int t : threads) {
                     for (Kernel k : {Kernel::Force, Kernel::Stiffness, Kernel::Kx}) {
                         const std::string name = std::string(name_of(k)) + "/" + to_string(b) + "/" + to_string(v) +
                                                  "/" + std::to_string(t) + "/" + mesh;
@@ -206,6 +277,11 @@ int main(int argc, char** argv) {
                             ->Unit(benchmark::kMicrosecond)
                             ->UseRealTime();
                     }
+                    const std::string name = std::string("step/") + to_string(b) + "/" + to_string(v) + "/" + std::to_string(t) + "/" + mesh;
+                    benchmark::RegisterBenchmark(name.c_str(), BM_Step, std::string(mesh), b, v, t)
+                        ->Unit(benchmark::kMicrosecond)
+                        ->UseRealTime();
+                }
     }
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();

@@ -174,6 +174,8 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
         }, opts.form_colouring);
     }
     switch (variant_) {
+        case Variant::Auto:  // resolved to a concrete variant by the constructor
+            break;
         case Variant::Colour: {
             vert_col_ = colour_vertex_segments(m_, resolved_vertex_colouring(opts.vertex_colouring, nv));
             tsep_col_ = colour_tsep_strain(m_, opts.segment_colouring);
@@ -310,6 +312,8 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
     });
     if constexpr (Kind == ModelKind::FE) {
         switch (variant_) {
+            case Variant::Auto:  // resolved to a concrete variant by the constructor
+                break;
             case Variant::Colour:
                 par::for_colours(*ex_, tsep_col_, [&](index_t e0, index_t) { kernel::tsep_strain_segment(m, e0, zeta, g); });
                 break;
@@ -343,6 +347,8 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
         }
     }
     switch (variant_) {
+        case Variant::Auto:  // resolved to a concrete variant by the constructor
+            break;
         case Variant::Colour:
             each_range(index_t(nf), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
             par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { kernel::edge_force_segment(m, a, p, g, f); });
@@ -412,6 +418,8 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
             return;
         }
         switch (variant_) {
+            case Variant::Auto:  // resolved to a concrete variant by the constructor
+                break;
             case Variant::Colour:
                 par::for_colours(*ex_, stiff_col_, [&](index_t e0, index_t) { kernel::tsep_stiffness_segment(m, e0, p, K); });
                 break;
@@ -443,6 +451,8 @@ void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S*
     const S* K = Ks.K.data();
     const auto& m = m_;
     switch (variant_) {
+        case Variant::Auto:  // resolved to a concrete variant by the constructor
+            break;
         case Variant::Colour:
             each_range(index_t(ny), [&](index_t b, index_t e) { std::fill(y + b, y + e, S(0)); });
             par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { kernel::edge_kx_segment(m, a, K, x, y); });
@@ -485,6 +495,8 @@ void ParallelEdgeKernels<S>::diagonal_blocks(const EdgeStiffness<S>& Ks, S* D) c
     const S* K = Ks.K.data();
     const auto& m = m_;
     switch (variant_) {
+        case Variant::Auto:  // resolved to a concrete variant by the constructor
+            break;
         case Variant::Colour:
             each_range(index_t(nd), [&](index_t b, index_t e) { std::fill(D + b, D + e, S(0)); });
             par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) {
