@@ -96,6 +96,14 @@ private:
         if (buf.size() != len * std::size_t(parts_)) buf.assign(len * std::size_t(parts_), T(0));
         return buf;
     }
+    // The edge-to-vertex scatter of the force and of K x (3 values per
+    // vertex; `out` is overwritten), by the variant's strategy, from the
+    // per-edge workers: segment(a, out[, fwd]) for the edges whose V0 is a,
+    // gather(v, incident edges, count, out) for vertex v, edge_to(i, add)
+    // adding through add(k, value), and edge(i, out).
+    template <class Segment, class Gather, class EdgeTo, class Edge>
+    void scatter_to_vertices(S* out, const Segment& segment, const Gather& gather, const EdgeTo& edge_to,
+                             const Edge& edge) const;
     // Incoming stiffness contributions per edge (the one-pass TSEP-list
     // stiffness of the gather and owner variants).
     void build_stiffness_sources();
@@ -300,8 +308,7 @@ void ParallelEdgeKernels<S>::reduce_parts(std::vector<U>& buf, std::size_t len, 
 template <class S>
 template <ModelKind Kind, bool Energy>
 double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const {
-    const index_t ne = m_.num_edges(), nv = m_.num_vertices;
-    const std::size_t nf = 3 * std::size_t(nv);
+    const index_t ne = m_.num_edges();
     st.resize(ne);
     S* p = st.p.data();
     S* zeta = st.zeta.data();
@@ -346,44 +353,11 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
             }
         }
     }
-    switch (variant_) {
-        case Variant::Auto:  // resolved to a concrete variant by the constructor
-            break;
-        case Variant::Colour:
-            each_range(index_t(nf), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
-            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { kernel::edge_force_segment(m, a, p, g, f); });
-            break;
-        case Variant::Gather:
-            each_range(nv, [&](index_t b, index_t e) {
-                for (index_t v = b; v < e; ++v)
-                    kernel::vertex_force_gather(v, &inc_[inc_first_[v]], inc_first_[v + 1] - inc_first_[v], p, g, f);
-            });
-            break;
-        case Variant::Atomic:
-            each_range(index_t(nf), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
-            each_range(ne, [&](index_t b, index_t e) {
-                for (index_t i = b; i < e; ++i)
-                    kernel::edge_force_to(m, i, p, g, [f](std::size_t k, S v) { par::atomic_add(f, k, v); });
-            });
-            break;
-        case Variant::Private: {
-            auto& buf = private_buffer(pv_, nf);
-            each_part(ne, [&](int part, index_t b, index_t e) {
-                S* fp = &buf[std::size_t(part) * nf];
-                for (index_t i = b; i < e; ++i) kernel::edge_force(m, i, p, g, fp);
-            });
-            reduce_parts(buf, nf, nf, f, false);
-            break;
-        }
-        case Variant::Owner:
-            // A part's own range is written by no other part before the
-            // barrier, so it is zeroed inside the part's work.
-            run_forward_spill<3>(*ex_, vspill_, f, spill_v_, [&](index_t, index_t b, index_t e, const auto& fwd) {
-                std::fill(f + 3 * std::size_t(b), f + 3 * std::size_t(e), S(0));
-                for (index_t a = b; a < e; ++a) kernel::edge_force_segment(m, a, p, g, f, fwd);
-            });
-            break;
-    }
+    scatter_to_vertices(
+        f, [&](index_t a, S* o, const auto&... fwd) { kernel::edge_force_segment(m, a, p, g, o, fwd...); },
+        [&](index_t v, const index_t* inc, index_t n, S* o) { kernel::vertex_force_gather(v, inc, n, p, g, o); },
+        [&](index_t i, const auto& add) { kernel::edge_force_to(m, i, p, g, add); },
+        [&](index_t i, S* o) { kernel::edge_force(m, i, p, g, o); });
     if constexpr (Energy)
         return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
     return 0;
@@ -446,43 +420,55 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
 
 template <class S>
 void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S* y) const {
-    const index_t ne = m_.num_edges(), nv = m_.num_vertices;
-    const std::size_t ny = 3 * std::size_t(nv);
     const S* K = Ks.K.data();
     const auto& m = m_;
+    scatter_to_vertices(
+        y, [&](index_t a, S* o, const auto&... fwd) { kernel::edge_kx_segment(m, a, K, x, o, fwd...); },
+        [&](index_t v, const index_t* inc, index_t n, S* o) { kernel::vertex_kx_gather(m, v, inc, n, K, x, o); },
+        [&](index_t i, const auto& add) { kernel::edge_kx_to(m, i, K, x, add); },
+        [&](index_t i, S* o) { kernel::edge_kx(m, i, K, x, o); });
+}
+
+template <class S>
+template <class Segment, class Gather, class EdgeTo, class Edge>
+void ParallelEdgeKernels<S>::scatter_to_vertices(S* out, const Segment& segment, const Gather& gather,
+                                                 const EdgeTo& edge_to, const Edge& edge) const {
+    const index_t ne = m_.num_edges(), nv = m_.num_vertices;
+    const std::size_t n = 3 * std::size_t(nv);
+    auto zero = [&] { each_range(index_t(n), [&](index_t b, index_t e) { std::fill(out + b, out + e, S(0)); }); };
     switch (variant_) {
         case Variant::Auto:  // resolved to a concrete variant by the constructor
             break;
         case Variant::Colour:
-            each_range(index_t(ny), [&](index_t b, index_t e) { std::fill(y + b, y + e, S(0)); });
-            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { kernel::edge_kx_segment(m, a, K, x, y); });
+            zero();
+            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { segment(a, out); });
             break;
         case Variant::Gather:
             each_range(nv, [&](index_t b, index_t e) {
-                for (index_t v = b; v < e; ++v)
-                    kernel::vertex_kx_gather(m, v, &inc_[inc_first_[v]], inc_first_[v + 1] - inc_first_[v], K, x, y);
+                for (index_t v = b; v < e; ++v) gather(v, &inc_[inc_first_[v]], inc_first_[v + 1] - inc_first_[v], out);
             });
             break;
         case Variant::Atomic:
-            each_range(index_t(ny), [&](index_t b, index_t e) { std::fill(y + b, y + e, S(0)); });
+            zero();
             each_range(ne, [&](index_t b, index_t e) {
-                for (index_t i = b; i < e; ++i)
-                    kernel::edge_kx_to(m, i, K, x, [y](std::size_t k, S v) { par::atomic_add(y, k, v); });
+                for (index_t i = b; i < e; ++i) edge_to(i, [out](std::size_t k, S v) { par::atomic_add(out, k, v); });
             });
             break;
         case Variant::Private: {
-            auto& buf = private_buffer(pv_, ny);
+            auto& buf = private_buffer(pv_, n);
             each_part(ne, [&](int part, index_t b, index_t e) {
-                S* yp = &buf[std::size_t(part) * ny];
-                for (index_t i = b; i < e; ++i) kernel::edge_kx(m, i, K, x, yp);
+                S* op = &buf[std::size_t(part) * n];
+                for (index_t i = b; i < e; ++i) edge(i, op);
             });
-            reduce_parts(buf, ny, ny, y, false);
+            reduce_parts(buf, n, n, out, false);
             break;
         }
         case Variant::Owner:
-            run_forward_spill<3>(*ex_, vspill_, y, spill_v_, [&](index_t, index_t b, index_t e, const auto& fwd) {
-                std::fill(y + 3 * std::size_t(b), y + 3 * std::size_t(e), S(0));
-                for (index_t a = b; a < e; ++a) kernel::edge_kx_segment(m, a, K, x, y, fwd);
+            // A part's own range is written by no other part before the
+            // barrier, so it is zeroed inside the part's work.
+            run_forward_spill<3>(*ex_, vspill_, out, spill_v_, [&](index_t, index_t b, index_t e, const auto& fwd) {
+                std::fill(out + 3 * std::size_t(b), out + 3 * std::size_t(e), S(0));
+                for (index_t a = b; a < e; ++a) segment(a, out, fwd);
             });
             break;
     }
