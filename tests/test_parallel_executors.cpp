@@ -31,6 +31,8 @@ TEST(Executors, EveryChunkOnce) {
 // scatter relies on).
 TEST(Executors, PhasesRunOnceAndInOrder) {
     const std::vector<index_t> chunks{3, 0, 1, 16, 2, 5};
+    std::vector<index_t> first{0};  // the offsets for_phases takes
+    for (index_t n : chunks) first.push_back(first.back() + n);
     for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB})
         for (int t : {1, 2, 3, 8})
             for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
@@ -39,7 +41,7 @@ TEST(Executors, PhasesRunOnceAndInOrder) {
                 for (index_t n : chunks) hits.emplace_back(n);
                 std::vector<std::atomic<int>> done(chunks.size());
                 std::atomic<int> out_of_order{0};
-                ex->for_phases(chunks, [&](int p, index_t c) {
+                ex->for_phases(int(chunks.size()), first.data(), [&](int p, index_t c) {
                     for (int q = 0; q < p; ++q)
                         if (done[q].load() != int(chunks[q])) out_of_order.fetch_add(1);
                     volatile double x = 0;  // a little work so that calls overlap

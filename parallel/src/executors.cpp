@@ -71,13 +71,13 @@ void OmpExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body
     }
 }
 
-void OmpExecutor::for_phases(const std::vector<index_t>& chunks,
+void OmpExecutor::for_phases(int phases, const index_t* chunk_first,
                              const std::function<void(int, index_t)>& body) const {
-    const int phases = int(chunks.size());
-    const index_t widest = phases > 0 ? *std::max_element(chunks.begin(), chunks.end()) : 0;
+    index_t widest = 0;
+    for (int p = 0; p < phases; ++p) widest = std::max(widest, chunk_first[p + 1] - chunk_first[p]);
     if (threads_ == 1 || widest <= 1) {
         for (int p = 0; p < phases; ++p)
-            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
         return;
     }
     const int t = threads_;
@@ -85,13 +85,13 @@ void OmpExecutor::for_phases(const std::vector<index_t>& chunks,
 #pragma omp parallel num_threads(t)
         for (int p = 0; p < phases; ++p) {
 #pragma omp for schedule(static)
-            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
         }
     } else {
 #pragma omp parallel num_threads(t)
         for (int p = 0; p < phases; ++p) {
 #pragma omp for schedule(dynamic, 1)
-            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
         }
     }
 }
@@ -133,24 +133,25 @@ void TbbExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body
     });
 }
 
-void TbbExecutor::for_phases(const std::vector<index_t>& chunks,
+void TbbExecutor::for_phases(int phases, const index_t* chunk_first,
                              const std::function<void(int, index_t)>& body) const {
     if (threads_ == 1) {
-        for (int p = 0; p < int(chunks.size()); ++p)
-            for (index_t c = 0; c < chunks[p]; ++c) body(p, c);
+        for (int p = 0; p < phases; ++p)
+            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
         return;
     }
     impl_->arena.execute([&] {
-        for (int p = 0; p < int(chunks.size()); ++p) {
+        for (int p = 0; p < phases; ++p) {
+            const index_t n = chunk_first[p + 1] - chunk_first[p];
             const auto run = [&](const tbb::blocked_range<index_t>& r) {
                 for (index_t c = r.begin(); c < r.end(); ++c) body(p, c);
             };
-            if (chunks[p] <= 1) {
-                if (chunks[p] == 1) body(p, 0);
+            if (n <= 1) {
+                if (n == 1) body(p, 0);
             } else if (schedule_ == Schedule::Static) {
-                tbb::parallel_for(tbb::blocked_range<index_t>(0, chunks[p], 1), run, tbb::static_partitioner());
+                tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 1), run, tbb::static_partitioner());
             } else {
-                tbb::parallel_for(tbb::blocked_range<index_t>(0, chunks[p], 1), run, tbb::simple_partitioner());
+                tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 1), run, tbb::simple_partitioner());
             }
         }
     });

@@ -22,13 +22,16 @@ public:
     // returns when all calls have finished.
     virtual void for_chunks(index_t n, const std::function<void(index_t)>& body) const = 0;
     // Phases one after another (the colours of a coloured scatter): in phase
-    // p, body(p, c) for every c in [0, chunks[p]), possibly concurrently.
-    // Same calls as one for_chunks per phase, which is the default; an
-    // executor may run all phases in one parallel region with a barrier
-    // between them (a barrier costs less than starting a region).
-    virtual void for_phases(const std::vector<index_t>& chunks,
+    // p < phases, body(p, c) for every c in [0, chunk_first[p + 1] -
+    // chunk_first[p]), possibly concurrently (offsets, as a Colouring keeps
+    // them: no per-call list). Same calls as one for_chunks per phase, which
+    // is the default; an executor may run all phases in one parallel region
+    // with a barrier between them (a barrier costs less than starting a
+    // region).
+    virtual void for_phases(int phases, const index_t* chunk_first,
                             const std::function<void(int, index_t)>& body) const {
-        for (int p = 0; p < int(chunks.size()); ++p) for_chunks(chunks[p], [&](index_t c) { body(p, c); });
+        for (int p = 0; p < phases; ++p)
+            for_chunks(chunk_first[p + 1] - chunk_first[p], [&](index_t c) { body(p, c); });
     }
 };
 

@@ -35,7 +35,7 @@ public:
     Schedule schedule() const { return schedule_; }
     void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
     // One parallel region for all phases, `omp for` (with its barrier) per phase.
-    void for_phases(const std::vector<index_t>& chunks,
+    void for_phases(int phases, const index_t* chunk_first,
                     const std::function<void(int, index_t)>& body) const override;
 
 private:
@@ -56,7 +56,7 @@ public:
     Schedule schedule() const { return schedule_; }
     void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
     // All phases inside one arena entry, one parallel_for per phase.
-    void for_phases(const std::vector<index_t>& chunks,
+    void for_phases(int phases, const index_t* chunk_first,
                     const std::function<void(int, index_t)>& body) const override;
 
 private:

@@ -31,9 +31,7 @@ inline index_t range_chunk(index_t n, index_t max_chunk) {
 // the chunks run concurrently (chunk_id is global, see Colouring).
 template <class Body>
 void for_colours(const Executor& ex, const Colouring& col, Body&& body) {
-    std::vector<index_t> chunks(col.colours());
-    for (int c = 0; c < col.colours(); ++c) chunks[c] = col.chunk_first[c + 1] - col.chunk_first[c];
-    ex.for_phases(chunks, [&](int c, index_t k) {
+    ex.for_phases(col.colours(), col.chunk_first.data(), [&](int c, index_t k) {
         const index_t ub = col.colour_first[c], ue = col.colour_first[c + 1];
         const index_t cu = col.chunk_units[c];
         const index_t end = std::min(ue, ub + (k + 1) * cu);
