@@ -55,27 +55,34 @@ std::vector<index_t> balanced_parts(std::span<const index_t> weight_first, index
 // targets in `out` and its forward targets through the kernel::ForwardOut
 // `fwd` (targets past `end` land in the part's window). `spill` must hold fs.spill_targets() * W zeros; it is left
 // zeroed.
+// Phase 2 of part p on its own: adds the windows of the earlier parts that
+// reach into its range to `out`, in part order, and zeroes them.
+template <int W, class T>
+void add_incoming_spills(const ForwardSpill& fs, index_t p, T* out, std::vector<T>& spill) {
+    const index_t begin = fs.part_first[p], end = fs.part_first[p + 1];
+    for (index_t k = fs.in_first[p]; k < fs.in_first[p + 1]; ++k) {
+        const index_t q = fs.in_part[k];
+        const index_t qend = fs.part_first[q + 1];
+        T* const window = spill.data() + W * fs.window_first[q];
+        const index_t lo = std::max(begin, qend), hi = std::min(end, fs.window_end[q]);
+        for (std::size_t i = W * std::size_t(lo); i < W * std::size_t(hi); ++i) {
+            T& s = window[i - W * std::size_t(qend)];
+            out[i] += s;
+            s = T(0);
+        }
+    }
+}
+
 template <int W, class T, class Body>
 void run_forward_spill(const Executor& ex, const ForwardSpill& fs, T* out, std::vector<T>& spill, Body&& body) {
     const index_t P = fs.parts();
     const index_t phase_first[3] = {0, P, 2 * P};
     ex.for_phases(2, phase_first, [&](int phase, index_t p) {
         const index_t begin = fs.part_first[p], end = fs.part_first[p + 1];
-        if (phase == 0) {
+        if (phase == 0)
             body(p, begin, end, kernel::ForwardOut<T>{out, spill.data() + W * fs.window_first[p], end});
-            return;
-        }
-        for (index_t k = fs.in_first[p]; k < fs.in_first[p + 1]; ++k) {
-            const index_t q = fs.in_part[k];
-            const index_t qend = fs.part_first[q + 1];
-            T* const window = spill.data() + W * fs.window_first[q];
-            const index_t lo = std::max(begin, qend), hi = std::min(end, fs.window_end[q]);
-            for (std::size_t i = W * std::size_t(lo); i < W * std::size_t(hi); ++i) {
-                T& s = window[i - W * std::size_t(qend)];
-                out[i] += s;
-                s = T(0);
-            }
-        }
+        else
+            add_incoming_spills<W>(fs, p, out, spill);
     });
 }
 

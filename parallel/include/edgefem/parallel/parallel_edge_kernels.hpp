@@ -101,6 +101,7 @@ private:
     // per-edge workers: segment(a, out[, fwd]) for the edges whose V0 is a,
     // gather(v, incident edges, count, out) for vertex v, edge_to(i, add)
     // adding through add(k, value), and edge(i, out).
+    void owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const;
     template <class Segment, class Gather, class EdgeTo, class Edge>
     void scatter_to_vertices(S* out, const Segment& segment, const Gather& gather, const EdgeTo& edge_to,
                              const Edge& edge) const;
@@ -135,6 +136,7 @@ private:
     // Owner variant: parts and spill windows (values per target: 3 for
     // forces and K x, 9 for diagonal blocks, 1 for g), kept zeroed.
     ForwardSpill vspill_, espill_;
+    std::vector<index_t> defer_end_;  // per part: its edges below this are deferred (owner_fused_forces)
     mutable std::vector<S> spill_v_, spill_d_;
     mutable std::vector<double> spill_g_;
     // Private accumulators (allocated on first use).
@@ -238,11 +240,23 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
         case Variant::Owner: {
             const auto& m = m_;
             if (vspill_.parts() == 0) vspill_ = vertex_spill(m, owner_parts);  // Auto has built it already
-            espill_ = make_forward_spill(ne, balanced_parts(m.tsep_first, owner_parts), [&m](index_t e0) {
+            // The TSEP loop's parts are the vertex parts' edge segments, so
+            // that it fuses with the edge scatter (owner_fused_forces).
+            std::vector<index_t> edge_first(vspill_.part_first.size());
+            for (std::size_t q = 0; q < edge_first.size(); ++q) edge_first[q] = m.edge_first[vspill_.part_first[q]];
+            espill_ = make_forward_spill(ne, edge_first, [&m](index_t e0) {
                 index_t t = e0;
                 for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) t = std::max(t, m.tsep_other[P]);
                 return t;
             });
+            // Edges of part q below the farthest window of the parts before
+            // it receive g terms only after the barrier: deferred.
+            defer_end_.resize(std::size_t(espill_.parts()));
+            index_t reach = 0;
+            for (index_t q = 0; q < espill_.parts(); ++q) {
+                defer_end_[q] = std::clamp(reach, espill_.part_first[q], espill_.part_first[q + 1]);
+                reach = std::max(reach, espill_.window_end[q]);
+            }
             spill_v_.assign(3 * vspill_.spill_targets(), S(0));
             spill_d_.assign(9 * vspill_.spill_targets(), S(0));
             spill_g_.assign(espill_.spill_targets(), 0.0);
@@ -314,6 +328,13 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
     S* zeta = st.zeta.data();
     double* g = st.g.data();
     const auto& m = m_;
+    if constexpr (Kind == ModelKind::FE)
+        if (variant_ == Variant::Owner) {
+            owner_fused_forces(u, f, st);
+            if constexpr (Energy)
+                return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
+            return 0;
+        }
     each_range(ne, [&](index_t b, index_t e) {
         for (index_t i = b; i < e; ++i) kernel::edge_strain(m, u, i, p, zeta, g);
     });
@@ -337,10 +358,7 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
                         kernel::tsep_strain_segment_to(m, i, zeta, [g](std::size_t k, double v) { par::atomic_add(g, k, v); });
                 });
                 break;
-            case Variant::Owner:
-                run_forward_spill<1>(*ex_, espill_, g, spill_g_, [&](index_t, index_t b, index_t e, const auto& fwd) {
-                    for (index_t i = b; i < e; ++i) kernel::tsep_strain_segment(m, i, zeta, g, fwd);
-                });
+            case Variant::Owner:  // owner_fused_forces
                 break;
             case Variant::Private: {
                 auto& buf = private_buffer(pg_, ne);
@@ -361,6 +379,47 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
     if constexpr (Energy)
         return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
     return 0;
+}
+
+// The owner variant's FE force in one region of 4 phases over the vertex
+// parts (the edge parts are the parts' edge segments): 0 strains of the
+// part's edges, f zeroed; 1 the fused TSEP + edge scatter of its segments
+// (kernel::tsep_force_segment; the edges that earlier parts' g windows reach
+// are deferred); 2 the incoming g windows added, then the deferred edges
+// scattered; 3 the incoming f windows added. Every sum has an order fixed
+// by the parts alone: bitwise the same for any thread count.
+template <class S>
+void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const {
+    const auto& m = m_;
+    const ForwardSpill &vs = vspill_, &es = espill_;
+    S* p = st.p.data();
+    S* zeta = st.zeta.data();
+    double* g = st.g.data();
+    const index_t P = vs.parts();
+    const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
+    ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
+        const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
+        const index_t eb = es.part_first[q], ee = es.part_first[q + 1];
+        const kernel::ForwardOut<S> fout{f, spill_v_.data() + 3 * vs.window_first[q], ve};
+        switch (phase) {
+            case 0:
+                for (index_t i = eb; i < ee; ++i) kernel::edge_strain(m, u, i, p, zeta, g);
+                std::fill(f + 3 * std::size_t(vb), f + 3 * std::size_t(ve), S(0));
+                break;
+            case 1: {
+                const kernel::ForwardOut<double> gout{g, spill_g_.data() + es.window_first[q], ee};
+                for (index_t a = vb; a < ve; ++a) kernel::tsep_force_segment(m, a, p, zeta, g, f, gout, fout, defer_end_[q]);
+                break;
+            }
+            case 2:
+                add_incoming_spills<1>(es, q, g, spill_g_);
+                for (index_t e = eb; e < defer_end_[q]; ++e) kernel::edge_force_deferred(m, e, p, g, f, fout);
+                break;
+            default:
+                add_incoming_spills<3>(vs, q, f, spill_v_);
+                break;
+        }
+    });
 }
 
 template <class S>
