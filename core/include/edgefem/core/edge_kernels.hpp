@@ -215,20 +215,16 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
 
 // The fused segment for one part of the owner-computes parallel force
 // (parallel/forward_spill.hpp): g writes past the part's edges go through
-// `gout`, f writes past its vertices through `fout`. Edges below
-// `defer_end` may still receive g terms from earlier parts' spill windows,
-// so here they only run their TSEP segment; edge_force_deferred scatters
-// them once the windows are added. The other edges are final when their
-// segment has run, as in the serial loop.
+// `gout`, f writes past its vertices through `fout`. An edge that also
+// receives g terms from earlier parts' spill windows scatters its partial g
+// here, and the rest with edge_force_add once the windows are in (the force
+// is linear in g).
 template <class S>
 inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const S* __restrict zeta,
                                double* __restrict g, S* __restrict f, const ForwardOut<double>& gout,
-                               const ForwardOut<S>& fout, index_t defer_end) {
+                               const ForwardOut<S>& fout) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
-    const index_t last = m.edge_first[a + 1];
-    index_t e = m.edge_first[a];
-    for (; e < last && e < defer_end; ++e) tsep_strain_segment(m, e, zeta, g, gout);
-    for (; e < last; ++e) {
+    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
         tsep_strain_segment(m, e, zeta, g, gout);
         const index_t b = m.edge[e][1];
         S* fb = b < fout.end ? fout.direct + 3 * std::size_t(b) : fout.spill + 3 * std::size_t(b - fout.end);
@@ -239,15 +235,15 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
     f[3 * std::size_t(a) + 2] += acc2;
 }
 
-// The scatter of an edge tsep_force_segment deferred: f(V0) += p~ g with V0
-// inside the part, f(V1) -= p~ g through `fout`.
+// f(V0) += p~ dg with V0 inside the part, f(V1) -= p~ dg through `fout`:
+// the rest of an edge's scatter when its g grew by dg.
 template <class S>
-inline void edge_force_deferred(const EdgeModel<S>& m, index_t e, const S* __restrict p, const double* __restrict g,
-                                S* __restrict f, const ForwardOut<S>& fout) {
+inline void edge_force_add(const EdgeModel<S>& m, index_t e, const S* __restrict p, double dg, S* __restrict f,
+                           const ForwardOut<S>& fout) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     S* fb = b < fout.end ? fout.direct + 3 * std::size_t(b) : fout.spill + 3 * std::size_t(b - fout.end);
     for (int r = 0; r < 3; ++r) {
-        const S v = p[3 * std::size_t(e) + r] * S(g[e]);
+        const S v = p[3 * std::size_t(e) + r] * S(dg);
         f[3 * std::size_t(a) + r] += v;
         fb[r] -= v;
     }

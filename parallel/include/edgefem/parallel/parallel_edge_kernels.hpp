@@ -69,6 +69,9 @@ public:
     // the TSEP loop (edges), with their spill windows.
     const ForwardSpill& vertex_parts() const { return vspill_; }
     const ForwardSpill& edge_parts() const { return espill_; }
+    // Edges whose force scatter waits for the barrier in the owner FE force
+    // (they receive g terms from earlier parts).
+    index_t deferred_edges() const { return index_t(defer_edges_.size()); }
     // Tet-local stiffness only: the colouring of the form's batches.
     const Colouring& form_colouring() const { return form_col_; }
     bool tet_local_stiffness() const { return form_.num_tets > 0; }
@@ -136,7 +139,9 @@ private:
     // Owner variant: parts and spill windows (values per target: 3 for
     // forces and K x, 9 for diagonal blocks, 1 for g), kept zeroed.
     ForwardSpill vspill_, espill_;
-    std::vector<index_t> defer_end_;  // per part: its edges below this are deferred (owner_fused_forces)
+    // owner_fused_forces: per part, the edges whose g gets terms from
+    // earlier parts' windows (offsets into a list).
+    std::vector<index_t> defer_first_, defer_edges_;
     mutable std::vector<S> spill_v_, spill_d_;
     mutable std::vector<double> spill_g_;
     // Private accumulators (allocated on first use).
@@ -249,13 +254,19 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
                 for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) t = std::max(t, m.tsep_other[P]);
                 return t;
             });
-            // Edges of part q below the farthest window of the parts before
-            // it receive g terms only after the barrier: deferred.
-            defer_end_.resize(std::size_t(espill_.parts()));
-            index_t reach = 0;
+            // The edges that receive g terms from an earlier part (through a
+            // spill window, so only after the barrier), per part.
+            std::vector<unsigned char> spilled(std::size_t(ne), 0);
+            for (index_t q = 0; q < espill_.parts(); ++q)
+                for (index_t e0 = espill_.part_first[q]; e0 < espill_.part_first[q + 1]; ++e0)
+                    for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P)
+                        if (m.tsep_other[P] >= espill_.part_first[q + 1]) spilled[m.tsep_other[P]] = 1;
+            defer_first_.assign(std::size_t(espill_.parts()) + 1, 0);
+            defer_edges_.clear();
             for (index_t q = 0; q < espill_.parts(); ++q) {
-                defer_end_[q] = std::clamp(reach, espill_.part_first[q], espill_.part_first[q + 1]);
-                reach = std::max(reach, espill_.window_end[q]);
+                for (index_t e = espill_.part_first[q]; e < espill_.part_first[q + 1]; ++e)
+                    if (spilled[e]) defer_edges_.push_back(e);
+                defer_first_[q + 1] = index_t(defer_edges_.size());
             }
             spill_v_.assign(3 * vspill_.spill_targets(), S(0));
             spill_d_.assign(9 * vspill_.spill_targets(), S(0));
@@ -298,7 +309,8 @@ std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
     for (const ForwardSpill* fs : {&vspill_, &espill_})
         b += bytes(fs->part_first) + bytes(fs->window_end) + bytes(fs->window_first) + bytes(fs->in_first) +
              bytes(fs->in_part);
-    b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_);
+    b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_) + bytes(defer_first_) +
+         bytes(defer_edges_);
     return b;
 }
 
@@ -384,10 +396,11 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
 // The owner variant's FE force in one region of 4 phases over the vertex
 // parts (the edge parts are the parts' edge segments): 0 strains of the
 // part's edges, f zeroed; 1 the fused TSEP + edge scatter of its segments
-// (kernel::tsep_force_segment; the edges that earlier parts' g windows reach
-// are deferred); 2 the incoming g windows added, then the deferred edges
-// scattered; 3 the incoming f windows added. Every sum has an order fixed
-// by the parts alone: bitwise the same for any thread count.
+// (kernel::tsep_force_segment), every edge with the g it has so far; 2 for
+// the edges that earlier parts' TSEPs write, their window terms added to g
+// and scattered (kernel::edge_force_add); 3 the incoming f windows added.
+// Every sum has an order fixed by the parts alone: bitwise the same for any
+// thread count.
 template <class S>
 void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const {
     const auto& m = m_;
@@ -408,12 +421,26 @@ void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& 
                 break;
             case 1: {
                 const kernel::ForwardOut<double> gout{g, spill_g_.data() + es.window_first[q], ee};
-                for (index_t a = vb; a < ve; ++a) kernel::tsep_force_segment(m, a, p, zeta, g, f, gout, fout, defer_end_[q]);
+                for (index_t a = vb; a < ve; ++a)
+                    kernel::tsep_force_segment(m, a, p, zeta, g, f, gout, fout);
                 break;
             }
             case 2:
-                add_incoming_spills<1>(es, q, g, spill_g_);
-                for (index_t e = eb; e < defer_end_[q]; ++e) kernel::edge_force_deferred(m, e, p, g, f, fout);
+                // Only the listed edges have non-zero window entries.
+                for (index_t k = defer_first_[q]; k < defer_first_[q + 1]; ++k) {
+                    const index_t e = defer_edges_[k];
+                    double dg = 0;
+                    for (index_t j = es.in_first[q]; j < es.in_first[q + 1]; ++j) {
+                        const index_t r = es.in_part[j], rend = es.part_first[r + 1];
+                        if (e < es.window_end[r]) {
+                            double& w = spill_g_[es.window_first[r] + std::size_t(e - rend)];
+                            dg += w;
+                            w = 0;
+                        }
+                    }
+                    g[e] += dg;
+                    kernel::edge_force_add(m, e, p, dg, f, fout);
+                }
                 break;
             default:
                 add_incoming_spills<3>(vs, q, f, spill_v_);
