@@ -47,6 +47,9 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
     const double bnorm = std::sqrt(blocked_sum(ex, n, [&](std::size_t i) { return free_dof[i] ? b[i] * b[i] : 0.0; }));
     const double scale = bnorm > 0 ? bnorm : 1.0;
 
+    // (Fusing each vector update into the dot product after it, one pass
+    // instead of two, measured 3 % slower per step on armadillo-7k: the
+    // updates no longer vectorise inside blocked_sum's 4-lane sums.)
     apply_A(x, w.Ap.data());
     each([&](std::size_t i) { w.r[i] = free_dof[i] ? b[i] - w.Ap[i] : 0.0; });
     CgResult res;
