@@ -188,6 +188,10 @@ inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
 // A gather form of g (each edge summing its own and its incoming TSEPs, no
 // g read-modify-writes) loads twice per pair and measured ~1.7x slower;
 // two accumulators in the segment changed nothing outside the noise.
+// Also measured and dropped (2026-11-22, RCM, 1 thread, same runs): the
+// pair loop unrolled by 2 (same sum order) ran armadillo-7k 13-15 % faster
+// but bunny-250k 9-12 % and box-1200 / bunny-4k 3-5 % slower; the sum over
+// zeta(E1) in a loop of its own before the g updates, 1.25-1.4x slower.
 template <class S>
 inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const S* __restrict zeta,
                                double* __restrict g, S* __restrict f) {
