@@ -8,10 +8,10 @@
 #include <cmath>
 #include <cstring>
 
-#include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
+#include "cantilever.hpp"
 #include "models.hpp"
 
 using namespace edgefem;
@@ -20,12 +20,7 @@ using edgefem::test::rel_diff;
 namespace {
 
 Scene cantilever(Method method) {
-    Scene s;
-    s.mesh = make_box(8, 3, 3);
-    s.materials = Material{2e4, 0.3, 1000};
-    s.gravity = {0, 0, -9.81};
-    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
-        if (s.mesh.X[3 * v] < -0.04 + 1e-9) s.fixed.push_back(v);
+    Scene s = edgefem::test::clamped_box_scene(8, 3, 3);
     s.integrator = Integrator::SemiImplicit;
     s.method = method;
     s.dt = 2e-3;

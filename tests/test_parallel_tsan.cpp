@@ -16,6 +16,7 @@
 #include "edgefem/parallel/parallel_edge_kernels.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
 #include "edgefem/parallel/parallel_tet_kernels.hpp"
+#include "cantilever.hpp"
 #include "models.hpp"
 
 using namespace edgefem;
@@ -83,12 +84,7 @@ TEST(ParallelTsan, EdgeKernels) {
 TEST(ParallelTsan, TetKernelsAndStep) {
     for (Method method : {Method::Edge, Method::Tet})
         for (Variant v : kAllVariants) {
-            Scene s;
-            s.mesh = make_box(5, 2, 2);
-            s.materials = Material{2e4, 0.3, 1000};
-            s.gravity = {0, 0, -9.81};
-            for (index_t i = 0; i < s.mesh.num_vertices(); ++i)
-                if (s.mesh.X[3 * i] < -0.02 + 1e-9) s.fixed.push_back(i);
+            Scene s = edgefem::test::clamped_box_scene(5, 2, 2);
             s.integrator = Integrator::SemiImplicit;
             s.method = method;
             s.dt = 2e-3;

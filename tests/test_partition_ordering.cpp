@@ -9,6 +9,7 @@
 #include "edgefem/partition/ordered_simulator.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
+#include "cantilever.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
 
@@ -80,12 +81,7 @@ TEST(Ordering, MetisPartsAreContiguousAndBadNamesRejected) {
 // The simulator on a renumbered scene, seen through the user's numbering,
 // follows the same trajectory as the simulator on the scene as given.
 TEST(Ordering, OrderedSimulatorIsInvisibleToTheUser) {
-    Scene s;
-    s.mesh = make_box(6, 3, 3);
-    s.materials = Material{5e4, 0.3, 1000};
-    s.gravity = {0, 0, -9.81};
-    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
-        if (s.mesh.X[3 * v] < -0.03 + 1e-9) s.fixed.push_back(v);
+    Scene s = edgefem::test::clamped_box_scene(6, 3, 3, 5e4);
     s.prescribed.push_back({s.mesh.num_vertices() - 1, {0.035, 0.02, 0.02}});
     s.solver.linear_solver = LinearSolver::Direct;
     Simulator<double> plain(s);
