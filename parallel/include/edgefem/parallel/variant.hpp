@@ -53,13 +53,23 @@ inline ColouringOptions blocked_vertex_colouring() {
 }
 
 // The owner variant's default part count: a function of the mesh only (so
-// results do not depend on the thread count), cbrt(#V) / 2.5 in 1..64. A
-// part's spill window spans about the ordering's bandwidth, ~#V^(2/3) for a
-// 3D mesh in RCM order, so this keeps the windows near 40 % of a part
-// (measured with RCM: 4 parts on bunny-4k, 40 %; 64 parts on bunny-250k,
-// 180 %, phase 2 then cost as much as phase 1).
+// results do not depend on the thread count), the power of two nearest to
+// cbrt(#V) / 2.5 (in log scale), 4..64. A part's spill window spans about
+// the ordering's bandwidth, ~#V^(2/3) for a 3D mesh in RCM order, so
+// cbrt(#V) / 2.5 keeps the windows near 40 % of a part (measured with RCM:
+// 4 parts on bunny-4k, 40 %; 64 parts on bunny-250k, 180 %, phase 2 then
+// cost as much as phase 1). A power of two splits evenly over 2, 4, 8 and 16
+// threads: on this 2-core VM (2026-11-22, bench_parallel, medians of 3)
+// armadillo-7k's 5 parts -> 4 took the 2-thread force from 115 to 86 us,
+// K x from 30.8 to 26.3 us and the step from 1.91 to 1.76 ms; box-1200's
+// 3 -> 4 the force from 18.3 to 16.2 us and K x from 6.45 to 5.45 us (2
+// parts were slower than 3); bunny-1m's 22 -> 16 the force from 20.4 to
+// 18.1 ms; bunny-250k's 14 -> 16 cost 6-7 % at 2 threads (14 already split
+// evenly there) and balances 16 threads.
 inline index_t default_owner_parts(index_t num_vertices) {
-    return std::clamp<index_t>(index_t(std::lround(std::cbrt(double(num_vertices)) / 2.5)), 1, 64);
+    const double x = std::cbrt(double(std::max<index_t>(num_vertices, 1))) / 2.5;
+    const int k = std::clamp(int(std::lround(std::log2(std::max(x, 1.0)))), 2, 6);
+    return index_t(1) << k;
 }
 
 // `o` with block 0 replaced by the per-mesh choice for `num_vertices`.
