@@ -111,10 +111,11 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant
                                                               plan_options(), prepared(mesh).form);
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (v == Variant::Colour && b == Backend::OpenMP && threads == 1)
-            std::fprintf(stderr, "%s colourings (plan %.2f s): vertex segments %s; tsep g %s; tsep K %s\n", mesh.c_str(), s,
-                         cur.k->vertex_colouring().stats().describe().c_str(),
+            std::fprintf(stderr, "%s colourings (plan %.2f s): vertex segments %s; tsep g %s; tsep K %s; tet-local K %s\n",
+                         mesh.c_str(), s, cur.k->vertex_colouring().stats().describe().c_str(),
                          cur.k->tsep_colouring().stats().describe().c_str(),
-                         cur.k->stiffness_colouring().stats().describe().c_str());
+                         cur.k->stiffness_colouring().stats().describe().c_str(),
+                         cur.k->form_colouring().stats().describe().c_str());
         if (v == Variant::Owner && b == Backend::OpenMP && threads == 1) {
             const ForwardSpill &vs = cur.k->vertex_parts(), &es = cur.k->edge_parts();
             std::fprintf(stderr,
