@@ -120,10 +120,10 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant
             const ForwardSpill &vs = cur.k->vertex_parts(), &es = cur.k->edge_parts();
             std::fprintf(stderr,
                          "%s owner parts: %d; spill windows %.1f%% of the vertices, %.1f%% of the edges; force "
-                         "scatter deferred for %.1f%% of the edges\n",
+                         "g corrected after the barrier on %.1f%% of the edges\n",
                          mesh.c_str(), int(vs.parts()), 100.0 * double(vs.spill_targets()) / std::max<index_t>(1, vs.items()),
                          100.0 * double(es.spill_targets()) / std::max<index_t>(1, es.items()),
-                         100.0 * double(cur.k->deferred_edges()) / std::max<index_t>(1, es.items()));
+                         100.0 * double(cur.k->corrected_edges()) / std::max<index_t>(1, es.items()));
         }
         cur.key = key;
     }

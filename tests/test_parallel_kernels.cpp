@@ -318,7 +318,9 @@ TEST(Colourings, ConflictFree) {
         EXPECT_EQ(colouring_conflicts(pk.form_colouring(), m.num_edges(), batch_w), 0) << nm.name;
         // The default plan's vertex-segment colouring (blocks chosen per mesh).
         EXPECT_EQ(colouring_conflicts(pk.vertex_colouring(), m.num_vertices, seg_w), 0) << nm.name;
-        if (m.num_vertices >= 64) EXPECT_GT(pk.vertex_colouring().colours(), 1) << nm.name;
+        if (m.num_vertices >= 64) {
+            EXPECT_GT(pk.vertex_colouring().colours(), 1) << nm.name;
+        }
         // The checker does catch a conflict.
         Colouring bad = colour_edges(m);
         if (m.num_edges() > 1) {

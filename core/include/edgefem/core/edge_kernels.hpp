@@ -88,6 +88,12 @@ inline index_t spill_start(index_t first, index_t last, Target&& target, const F
     while (target(mid) < out.end) ++mid;
     return mid;
 }
+// The row of target t (W values per target): in `direct` below `end`, else
+// in `spill`.
+template <int W, class T>
+inline T* forward_row(const ForwardOut<T>& out, index_t t) {
+    return t < out.end ? out.direct + W * std::size_t(t) : out.spill + W * std::size_t(t - out.end);
+}
 // body(i, row of target(i)) for i in [first, last), W values per target.
 template <int W, class T, class Target, class Body>
 inline void for_segment(index_t first, index_t last, Target&& target, const ForwardOut<T>& out, Body&& body) {
@@ -228,12 +234,11 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
                                double* __restrict g, S* __restrict f, const ForwardOut<double>& gout,
                                const ForwardOut<S>& fout) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
-    for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
-        tsep_strain_segment(m, e, zeta, g, gout);
-        const index_t b = m.edge[e][1];
-        S* fb = b < fout.end ? fout.direct + 3 * std::size_t(b) : fout.spill + 3 * std::size_t(b - fout.end);
-        edge_force_terms(p, e, S(g[e]), acc0, acc1, acc2, fb);
-    }
+    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, fout,
+                   [&](index_t e, S* fb) {
+                       tsep_strain_segment(m, e, zeta, g, gout);
+                       edge_force_terms(p, e, S(g[e]), acc0, acc1, acc2, fb);
+                   });
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
     f[3 * std::size_t(a) + 2] += acc2;
@@ -244,8 +249,8 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
 template <class S>
 inline void edge_force_add(const EdgeModel<S>& m, index_t e, const S* __restrict p, double dg, S* __restrict f,
                            const ForwardOut<S>& fout) {
-    const index_t a = m.edge[e][0], b = m.edge[e][1];
-    S* fb = b < fout.end ? fout.direct + 3 * std::size_t(b) : fout.spill + 3 * std::size_t(b - fout.end);
+    const index_t a = m.edge[e][0];
+    S* fb = forward_row<3>(fout, m.edge[e][1]);
     for (int r = 0; r < 3; ++r) {
         const S v = p[3 * std::size_t(e) + r] * S(dg);
         f[3 * std::size_t(a) + r] += v;

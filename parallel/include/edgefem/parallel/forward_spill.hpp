@@ -50,11 +50,6 @@ ForwardSpill make_forward_spill(index_t n, std::span<const index_t> part_first,
 // vertex's segment length). Parts may be empty only when n < parts.
 std::vector<index_t> balanced_parts(std::span<const index_t> weight_first, index_t parts);
 
-// Runs one owner-computes scatter with W values per target: body(part,
-// begin, end, fwd) runs items [begin, end) of the part, writing its own
-// targets in `out` and its forward targets through the kernel::ForwardOut
-// `fwd` (targets past `end` land in the part's window). `spill` must hold fs.spill_targets() * W zeros; it is left
-// zeroed.
 // Phase 2 of part p on its own: adds the windows of the earlier parts that
 // reach into its range to `out`, in part order, and zeroes them.
 template <int W, class T>
@@ -73,6 +68,27 @@ void add_incoming_spills(const ForwardSpill& fs, index_t p, T* out, std::vector<
     }
 }
 
+// The same for one target t of part p (W = 1): the sum, in part order, of
+// what the earlier parts' windows hold for t, which are zeroed.
+template <class T>
+T take_incoming_spill(const ForwardSpill& fs, index_t p, index_t t, std::vector<T>& spill) {
+    T sum = T(0);
+    for (index_t k = fs.in_first[p]; k < fs.in_first[p + 1]; ++k) {
+        const index_t q = fs.in_part[k];
+        if (t < fs.window_end[q]) {
+            T& s = spill[fs.window_first[q] + std::size_t(t - fs.part_first[q + 1])];
+            sum += s;
+            s = T(0);
+        }
+    }
+    return sum;
+}
+
+// Runs one owner-computes scatter with W values per target: body(part,
+// begin, end, fwd) runs items [begin, end) of the part, writing its own
+// targets in `out` and its forward targets through the kernel::ForwardOut
+// `fwd` (targets past `end` land in the part's window). `spill` must hold
+// fs.spill_targets() * W zeros; it is left zeroed.
 template <int W, class T, class Body>
 void run_forward_spill(const Executor& ex, const ForwardSpill& fs, T* out, std::vector<T>& spill, Body&& body) {
     const index_t P = fs.parts();

@@ -69,9 +69,9 @@ public:
     // the TSEP loop (edges), with their spill windows.
     const ForwardSpill& vertex_parts() const { return vspill_; }
     const ForwardSpill& edge_parts() const { return espill_; }
-    // Edges whose force scatter waits for the barrier in the owner FE force
-    // (they receive g terms from earlier parts).
-    index_t deferred_edges() const { return index_t(defer_edges_.size()); }
+    // Edges of the owner FE force that receive g terms from earlier parts:
+    // scattered with a correction after the barrier.
+    index_t corrected_edges() const { return index_t(corr_edges_.size()); }
     // Tet-local stiffness only: the colouring of the form's batches.
     const Colouring& form_colouring() const { return form_col_; }
     bool tet_local_stiffness() const { return form_.num_tets > 0; }
@@ -141,7 +141,7 @@ private:
     ForwardSpill vspill_, espill_;
     // owner_fused_forces: per part, the edges whose g gets terms from
     // earlier parts' windows (offsets into a list).
-    std::vector<index_t> defer_first_, defer_edges_;
+    std::vector<index_t> corr_first_, corr_edges_;
     mutable std::vector<S> spill_v_, spill_d_;
     mutable std::vector<double> spill_g_;
     // Private accumulators (allocated on first use).
@@ -261,12 +261,12 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
                 for (index_t e0 = espill_.part_first[q]; e0 < espill_.part_first[q + 1]; ++e0)
                     for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P)
                         if (m.tsep_other[P] >= espill_.part_first[q + 1]) spilled[m.tsep_other[P]] = 1;
-            defer_first_.assign(std::size_t(espill_.parts()) + 1, 0);
-            defer_edges_.clear();
+            corr_first_.assign(std::size_t(espill_.parts()) + 1, 0);
+            corr_edges_.clear();
             for (index_t q = 0; q < espill_.parts(); ++q) {
                 for (index_t e = espill_.part_first[q]; e < espill_.part_first[q + 1]; ++e)
-                    if (spilled[e]) defer_edges_.push_back(e);
-                defer_first_[q + 1] = index_t(defer_edges_.size());
+                    if (spilled[e]) corr_edges_.push_back(e);
+                corr_first_[q + 1] = index_t(corr_edges_.size());
             }
             spill_v_.assign(3 * vspill_.spill_targets(), S(0));
             spill_d_.assign(9 * vspill_.spill_targets(), S(0));
@@ -309,8 +309,8 @@ std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
     for (const ForwardSpill* fs : {&vspill_, &espill_})
         b += bytes(fs->part_first) + bytes(fs->window_end) + bytes(fs->window_first) + bytes(fs->in_first) +
              bytes(fs->in_part);
-    b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_) + bytes(defer_first_) +
-         bytes(defer_edges_);
+    b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_) + bytes(corr_first_) +
+         bytes(corr_edges_);
     return b;
 }
 
@@ -427,17 +427,9 @@ void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& 
             }
             case 2:
                 // Only the listed edges have non-zero window entries.
-                for (index_t k = defer_first_[q]; k < defer_first_[q + 1]; ++k) {
-                    const index_t e = defer_edges_[k];
-                    double dg = 0;
-                    for (index_t j = es.in_first[q]; j < es.in_first[q + 1]; ++j) {
-                        const index_t r = es.in_part[j], rend = es.part_first[r + 1];
-                        if (e < es.window_end[r]) {
-                            double& w = spill_g_[es.window_first[r] + std::size_t(e - rend)];
-                            dg += w;
-                            w = 0;
-                        }
-                    }
+                for (index_t k = corr_first_[q]; k < corr_first_[q + 1]; ++k) {
+                    const index_t e = corr_edges_[k];
+                    const double dg = take_incoming_spill(es, q, e, spill_g_);
                     g[e] += dg;
                     kernel::edge_force_add(m, e, p, dg, f, fout);
                 }
