@@ -90,7 +90,11 @@ double force_bytes(const EdgeModel<double>& m) {
 // function of #V, variant.hpp), for studies of its balance at many threads.
 PlanOptions plan_options() {
     PlanOptions o;
-    if (const char* env = std::getenv("EDGEFEM_OWNER_PARTS"); env && *env) o.owner_parts = std::max(0, std::atoi(env));
+    if (const char* env = std::getenv("EDGEFEM_OWNER_PARTS"); env && *env) {
+        o.owner_parts = std::max(0, std::atoi(env));
+        if (o.owner_parts == 0)
+            std::fprintf(stderr, "EDGEFEM_OWNER_PARTS=%s is not a positive count; using the default\n", env);
+    }
     return o;
 }
 
