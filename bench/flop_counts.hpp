@@ -86,9 +86,10 @@ inline Count edge_stiffness(const Items& n, ModelKind kind) {
     return {v, v};
 }
 // FE stiffness from the tet-local form (the default layout): the edge terms,
-// then every lane of every 8-tet batch.
+// then every lane of every batch (kTetLanes<double> tets; the counts are taken
+// in double).
 inline Count edge_stiffness_tet_local(const Items& n) {
-    const double lanes = std::ceil(n.T / kTetLanes) * kTetLanes;
+    const double lanes = std::ceil(n.T / kTetLanes<double>) * kTetLanes<double>;
     const double v = n.E * kEdgeStiffness + lanes * kTetFormStiffnessPerLane;
     return {v, v};
 }

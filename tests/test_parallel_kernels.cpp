@@ -311,7 +311,7 @@ TEST(Colourings, ConflictFree) {
         // of its tets, taken from the topology through the form's slot -> tet map.
         const auto form = make_tet_edge_form<double>(nm.mesh, topo, Materials(Material{}));
         const ResourceFn batch_w = [&](index_t b, std::vector<index_t>& out) {
-            for (index_t s = b * kTetLanes; s < std::min<index_t>(topo.num_tets, (b + 1) * kTetLanes); ++s)
+            for (index_t s = b * kTetLanes<double>; s < std::min<index_t>(topo.num_tets, (b + 1) * kTetLanes<double>); ++s)
                 for (index_t e : topo.tet_edges[form.slot_tet[s]]) out.push_back(e);
         };
         const ParallelEdgeKernels<double> pk(m, std::make_shared<SerialExecutor>(), Variant::Colour, {}, form);

@@ -61,13 +61,13 @@ TEST(TetEdgeForm, EdgesAreTheTetsEdges) {
             const index_t tet = form.slot_tet[t];
             ASSERT_TRUE(tet >= 0 && tet < topo.num_tets && seen[tet]++ == 0) << name << " slot " << t;
             std::array<index_t, 6> a{}, b = topo.tet_edges[tet];
-            for (int k = 0; k < 6; ++k) a[k] = form.edge[(t / kTetLanes * 6 + k) * kTetLanes + t % kTetLanes];
+            for (int k = 0; k < 6; ++k) a[k] = form.edge[(t / kTetLanes<double> * 6 + k) * kTetLanes<double> + t % kTetLanes<double>];
             std::sort(a.begin(), a.end());
             std::sort(b.begin(), b.end());
             ASSERT_EQ(a, b) << name << " tet " << t;
         }
-        for (index_t t = topo.num_tets; t < form.num_batches() * kTetLanes; ++t)
+        for (index_t t = topo.num_tets; t < form.num_batches() * kTetLanes<double>; ++t)
             for (int r = 0; r < kFormRows; ++r)
-                ASSERT_EQ(form.A[(t / kTetLanes * kFormRows + r) * kTetLanes + t % kTetLanes], 0.0) << name;
+                ASSERT_EQ(form.A[(t / kTetLanes<double> * kFormRows + r) * kTetLanes<double> + t % kTetLanes<double>], 0.0) << name;
     }
 }

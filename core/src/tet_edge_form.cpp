@@ -11,7 +11,7 @@ namespace edgefem {
 template <class S>
 TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const Materials& materials) {
     materials.validate();
-    constexpr int L = kTetLanes;
+    constexpr int L = kTetLanes<S>;
     TetEdgeForm<S> f;
     f.num_tets = topo.num_tets;
     f.num_edges = topo.num_edges();

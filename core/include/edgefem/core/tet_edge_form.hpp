@@ -11,7 +11,7 @@
 // (s_ka = +1 when a is V0 of edge k, -1 when it is V1), computed in
 // registers and scattered once each: 6 block updates per tet.
 //
-// Layout: tets in batches of kTetLanes, structure-of-arrays inside a batch,
+// Layout: tets in batches of kTetLanes<S>, structure-of-arrays inside a batch,
 // so the per-tet arithmetic runs across the batch's tets in SIMD lanes;
 // tets sorted by their vertices, so neighbouring tets update neighbouring
 // K(E) blocks.
@@ -31,7 +31,13 @@
 
 namespace edgefem {
 
-inline constexpr int kTetLanes = 8;
+// Tets per batch: one 32-byte vector of S per value. Measured on bunny-4k
+// and armadillo-7k (bench_kernels, 1 thread): double with 4 lanes builds K
+// in 47-50 ns/tet against 60-62 with 8 (twice the registers per value spill
+// the 72 W vectors), and float keeps 8 (29-34 against 41-43 with 4; its
+// scatter transposes 4 x 4 lanes in registers).
+template <class S>
+inline constexpr int kTetLanes = std::is_same_v<S, float> ? 8 : 4;
 
 // Row of A_kl in a batch: the upper triangle without the diagonal, row by
 // row; the diagonal reads row 15, which holds zeros (so the kernels stay
@@ -48,17 +54,17 @@ template <class S>
 struct TetEdgeForm {
     index_t num_tets = 0;
     index_t num_edges = 0;
-    // Batch b, local edge k, lane l: edge[(b * 6 + k) * kTetLanes + l]. Lanes
+    // Batch b, local edge k, lane l: edge[(b * 6 + k) * kTetLanes<S> + l]. Lanes
     // past num_tets in the last batch hold edge 0 and A = 0.
     std::vector<index_t> edge;
-    // A[(b * kFormRows + kSym[k][l]) * kTetLanes + lane].
+    // A[(b * kFormRows + kSym[k][l]) * kTetLanes<S> + lane].
     std::vector<S> A;
-    // The tet in each slot (batch * kTetLanes + lane), for inspection only:
+    // The tet in each slot (batch * kTetLanes<S> + lane), for inspection only:
     // the kernels never read it. Tets are stored sorted by their vertices.
     std::vector<index_t> slot_tet;
 
-    index_t num_batches() const { return (num_tets + kTetLanes - 1) / kTetLanes; }
-    index_t batch_size(index_t b) const { return std::min<index_t>(kTetLanes, num_tets - b * kTetLanes); }
+    index_t num_batches() const { return (num_tets + kTetLanes<S> - 1) / kTetLanes<S>; }
+    index_t batch_size(index_t b) const { return std::min<index_t>(kTetLanes<S>, num_tets - b * kTetLanes<S>); }
     double bytes_per_tet() const {
         return num_tets > 0 ? double(edge.size() * sizeof(index_t) + A.size() * sizeof(S)) / num_tets : 0.0;
     }
@@ -67,6 +73,7 @@ struct TetEdgeForm {
 // The same form in another scalar type (e.g. the operation-counting one).
 template <class To, class From>
 TetEdgeForm<To> convert_scalar(const TetEdgeForm<From>& f) {
+    static_assert(kTetLanes<To> == kTetLanes<From>, "the batch layout depends on the lane count");
     TetEdgeForm<To> c;
     c.num_tets = f.num_tets;
     c.num_edges = f.num_edges;
@@ -82,57 +89,68 @@ TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const 
 
 namespace kernel {
 
-// kTetLanes values of S, one per tet of a batch: a GCC/Clang vector for
+// kTetLanes<S> values of S, one per tet of a batch: a GCC/Clang vector for
 // built-in scalars (the arithmetic runs in SIMD registers), and for other
 // scalars (the operation-counting scalar of bench/counting_scalar.hpp) an
 // array with the same element-wise operators, so the same kernel source
 // runs on both.
 template <class S>
 struct LaneArray {
-    S v[kTetLanes] = {};
+    S v[kTetLanes<S>] = {};
     S& operator[](int l) { return v[l]; }
     const S& operator[](int l) const { return v[l]; }
     friend LaneArray operator+(const LaneArray& a, const LaneArray& b) {
         LaneArray r;
-        for (int l = 0; l < kTetLanes; ++l) r.v[l] = a.v[l] + b.v[l];
+        for (int l = 0; l < kTetLanes<S>; ++l) r.v[l] = a.v[l] + b.v[l];
         return r;
     }
     friend LaneArray operator*(const LaneArray& a, const LaneArray& b) {
         LaneArray r;
-        for (int l = 0; l < kTetLanes; ++l) r.v[l] = a.v[l] * b.v[l];
+        for (int l = 0; l < kTetLanes<S>; ++l) r.v[l] = a.v[l] * b.v[l];
         return r;
     }
     friend LaneArray operator*(const S& a, const LaneArray& b) {
         LaneArray r;
-        for (int l = 0; l < kTetLanes; ++l) r.v[l] = a * b.v[l];
+        for (int l = 0; l < kTetLanes<S>; ++l) r.v[l] = a * b.v[l];
         return r;
     }
     LaneArray& operator+=(const LaneArray& b) {
-        for (int l = 0; l < kTetLanes; ++l) v[l] += b.v[l];
+        for (int l = 0; l < kTetLanes<S>; ++l) v[l] += b.v[l];
         return *this;
     }
 };
 template <class S, bool = std::is_arithmetic_v<S>>
 struct Lanes {
-    typedef S type __attribute__((vector_size(sizeof(S) * kTetLanes)));
+    typedef S type __attribute__((vector_size(sizeof(S) * kTetLanes<S>)));
 };
 template <class S>
 struct Lanes<S, false> {
     using type = LaneArray<S>;
 };
 
+// L doubles in one GCC/Clang vector (a class template: the attribute on a
+// typedef whose size depends on a template parameter is ignored inside a
+// function template).
+template <int L>
+struct DoubleLanes {
+    typedef double type __attribute__((vector_size(sizeof(double) * L)));
+};
+
 // Adds each tet's share of sum_{F != E} A_EF zeta(F) to g(E) for batch b
 // (g in double whatever S is, as EdgeState::g).
 template <class S>
 inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g) {
-    constexpr int L = kTetLanes;
+    constexpr int L = kTetLanes<S>;
     // Lanes in registers, as in tet_form_stiffness (no stack round trip).
-    typedef double V __attribute__((vector_size(sizeof(double) * L)));
+    using V = typename DoubleLanes<L>::type;
     const index_t* E = &f.edge[std::size_t(b) * 6 * L];
     const S* A = &f.A[std::size_t(b) * kFormRows * L];
     V Z[6];
-    for (int k = 0; k < 6; ++k)
-        for (int l = 0; l < L; ++l) Z[k][l] = double(zeta[E[k * L + l]]);
+    for (int k = 0; k < 6; ++k) {
+        double z[L];  // lanes through an array: per-lane writes into Z[k] warn (-Wmaybe-uninitialized)
+        for (int l = 0; l < L; ++l) z[l] = double(zeta[E[k * L + l]]);
+        __builtin_memcpy(&Z[k], z, sizeof(V));
+    }
     const int n = f.batch_size(b);
 #pragma GCC unroll 6
     for (int k = 0; k < 6; ++k) {
@@ -159,11 +177,11 @@ inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restr
 // 32-byte updates of 72-byte blocks straddle cache lines and lose (50 -> 58),
 // so double stays scalar.
 template <class V, class S>
-inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes]) {
+inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes<S>]) {
     if constexpr (!std::is_same_v<S, float>) {
         for (int x = 0; x < 9; ++x)
 #pragma GCC unroll 8
-            for (int l = 0; l < kTetLanes; ++l) blk[l][x] += kv[x][l];
+            for (int l = 0; l < kTetLanes<S>; ++l) blk[l][x] += kv[x][l];
     } else {
         typedef S V4 __attribute__((vector_size(sizeof(S) * 4)));
         auto add4 = [](S* dst, V4 v) {
@@ -172,7 +190,7 @@ inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes]) {
             d += v;
             __builtin_memcpy(dst, &d, sizeof(V4));
         };
-        static_assert(kTetLanes == 8);
+        static_assert(kTetLanes<S> == 8);
 #pragma GCC unroll 2
         for (int h = 0; h < 2; ++h) {
             V4 r[8];
@@ -191,7 +209,7 @@ inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes]) {
             }
         }
 #pragma GCC unroll 8
-        for (int l = 0; l < kTetLanes; ++l) blk[l][8] += kv[8][l];
+        for (int l = 0; l < kTetLanes<S>; ++l) blk[l][8] += kv[8][l];
     }
 }
 
@@ -200,7 +218,7 @@ inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes]) {
 // sink) for batch b, from the current edge vectors p~ (3 #E).
 template <class S>
 inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __restrict p, S* __restrict K) {
-    constexpr int L = kTetLanes;
+    constexpr int L = kTetLanes<S>;
     // One value per lane in a register: the blocks are scattered straight
     // from registers (a stack array written as vectors and re-read per lane
     // stalls every read on store forwarding: measured 2x slower).

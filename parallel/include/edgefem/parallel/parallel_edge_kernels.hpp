@@ -185,7 +185,7 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
         const auto& f = form_;
         form_col_ = colour_items(f.num_batches(), ne, [&f](index_t b, std::vector<index_t>& out) {
             for (int k = 0; k < 6; ++k)
-                for (int l = 0; l < f.batch_size(b); ++l) out.push_back(f.edge[(std::size_t(b) * 6 + k) * kTetLanes + l]);
+                for (int l = 0; l < f.batch_size(b); ++l) out.push_back(f.edge[(std::size_t(b) * 6 + k) * kTetLanes<S> + l]);
         }, opts.form_colouring);
     }
     switch (variant_) {

@@ -91,7 +91,7 @@ struct PlanOptions {
     ColouringOptions segment_colouring = blocked_colouring();  // TSEP segments (g, K)
     ColouringOptions tet_colouring;      // per-tet scatter
     // FE stiffness from the tet-local form (default) or the TSEP list, and
-    // the colouring of the form's 8-tet batches (units of 8 batches).
+    // the colouring of the form's batches (kTetLanes tets; units of 8 batches).
     StiffnessLayout stiffness_layout = StiffnessLayout::TetLocal;
     ColouringOptions form_colouring = form_batch_colouring();
     index_t range_chunk = 2048;          // items per chunk of the uncoloured loops
