@@ -76,20 +76,27 @@ Prepared& prepared(const std::string& name) {
 // Compulsory traffic of one FE force call (each array streamed once per
 // pass that touches it; random reads of u and zeta counted once):
 // pass 1 reads edge, rest, L(E), u and writes p~, zeta, g; pass 2 reads the
-// segments (first, E1, L(P)), zeta and updates g; pass 3 reads edge, p~, g
-// and writes f (zeroed first).
-double force_bytes(const EdgeModel<double>& m) {
+// segments (first, E1, L(P)) or, with the tet-local form, its edge ids and
+// rows, reads zeta and updates g; pass 3 reads edge, p~, g and writes f
+// (zeroed first).
+double force_bytes(const Prepared& p, bool form) {
+    const EdgeModel<double>& m = p.model;
     const double E = m.num_edges(), P = m.num_tseps(), V = m.num_vertices, s = sizeof(double);
     const double pass1 = E * (8 + 3 * s + s) + 3 * s * V + E * (3 * s + s + 8);
-    const double pass2 = E * 4 + P * (4 + s) + E * s + 2 * E * 8;
+    const double pairs = form ? double(p.form.edge.size() * sizeof(index_t) + p.form.A.size() * sizeof(double))
+                              : E * 4 + P * (4 + s);
+    const double pass2 = pairs + E * s + 2 * E * 8;
     const double pass3 = E * (8 + 3 * s + 8) + 2 * 3 * s * V;
     return pass1 + pass2 + pass3;
 }
 
 // $EDGEFEM_OWNER_PARTS: the owner variant's part count (default: a
 // function of #V, variant.hpp), for studies of its balance at many threads.
+// $EDGEFEM_FORM_FORCES=0: the FE forces take g from the variant's TSEP loop
+// instead of the tet-local form (PlanOptions::form_forces).
 PlanOptions plan_options() {
     PlanOptions o;
+    if (const char* env = std::getenv("EDGEFEM_FORM_FORCES"); env && *env) o.form_forces = std::atoi(env) != 0;
     if (const char* env = std::getenv("EDGEFEM_OWNER_PARTS"); env && *env) {
         o.owner_parts = std::max(0, std::atoi(env));
         if (o.owner_parts == 0)
@@ -134,11 +141,12 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant
     return *cur.k;
 }
 
-void set_counters(benchmark::State& state, const Prepared& p, Kernel k) {
+// `form`: the force takes g from the tet-local form.
+void set_counters(benchmark::State& state, const Prepared& p, Kernel k, bool form) {
     state.counters["per_tet"] = benchmark::Counter(double(p.model.num_tets),
                                                    benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
     if (k == Kernel::Force) {
-        const double bytes = force_bytes(p.model);
+        const double bytes = force_bytes(p, form);
         state.counters["bytes"] = bytes;
         state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
     }
@@ -149,11 +157,20 @@ void BM_Core(benchmark::State& state, std::string mesh, Kernel k) {
     std::vector<double> f(p.u.size()), y(p.u.size());
     EdgeState<double> st;
     EdgeStiffness<double> K;
-    edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st);
+    // The serial operator's force: g from the tet-local form unless
+    // $EDGEFEM_FORM_FORCES=0 (then the fused TSEP loop).
+    const bool form_forces = plan_options().form_forces;
+    const auto force = [&] {
+        if (form_forces)
+            tet_form_forces<ModelKind::FE, false>(p.model, p.form, p.u.data(), f.data(), st);
+        else
+            edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st);
+    };
+    force();
     tet_form_stiffness_all<ModelKind::FE>(p.model, p.form, st, K);
     for (auto _ : state) {
         switch (k) {
-            case Kernel::Force: edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st); break;
+            case Kernel::Force: force(); break;
             case Kernel::Stiffness: tet_form_stiffness_all<ModelKind::FE>(p.model, p.form, st, K); break;
             case Kernel::Kx: edge_multiply(p.model, K, p.x.data(), y.data()); break;
         }
@@ -161,7 +178,7 @@ void BM_Core(benchmark::State& state, std::string mesh, Kernel k) {
         benchmark::DoNotOptimize(y.data());
         benchmark::ClobberMemory();
     }
-    set_counters(state, p, k);
+    set_counters(state, p, k, form_forces);
 }
 
 void BM_Parallel(benchmark::State& state, std::string mesh, Kernel k, Backend b, Variant v, int threads) {
@@ -182,7 +199,7 @@ void BM_Parallel(benchmark::State& state, std::string mesh, Kernel k, Backend b,
         benchmark::DoNotOptimize(y.data());
         benchmark::ClobberMemory();
     }
-    set_counters(state, p, k);
+    set_counters(state, p, k, kern.form_forces());
 }
 
 // One semi-implicit step (bench_step's scene, 20 warm-started CG

@@ -75,6 +75,7 @@ struct Measured {
     std::int64_t edge_force_fe = 0, edge_force_sn = 0, edge_stiffness_fe = 0, edge_stiffness_sn = 0, edge_kx = 0;
     std::int64_t tet_force = 0, tet_stiffness = 0, tet_kx = 0;
     std::int64_t edge_stiffness_fe_tet_local = 0;  // FE stiffness from the tet-local form (when given)
+    std::int64_t edge_force_fe_tet_local = 0;      // FE forces with the tet-local form's g pass (when given)
 };
 
 inline Measured count_kernels(const EdgeModel<double>& edge_d, const TetModel<double>& tet_d,
@@ -98,6 +99,7 @@ inline Measured count_kernels(const EdgeModel<double>& edge_d, const TetModel<do
     r.edge_kx = count([&] { edge_multiply(em, K, x.data(), y.data()); });
     if (form_d) {
         const TetEdgeForm<Counted> form = convert_scalar<Counted>(*form_d);
+        r.edge_force_fe_tet_local = count([&] { tet_form_forces<ModelKind::FE, false>(em, form, u.data(), f.data(), st); });
         r.edge_stiffness_fe_tet_local = count([&] { tet_form_stiffness_all<ModelKind::FE>(em, form, st, K); });
     }
     TetStiffness<Counted> Kt;

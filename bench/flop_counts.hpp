@@ -29,6 +29,11 @@ inline constexpr long kEdgeStrain = 15;
 inline constexpr long kTsepStrainDouble = 4;
 // tsep_strain_segment, per edge (segment): g(E0) += acc 1 (double).
 inline constexpr long kSegmentStrainDouble = 1;
+// tet_form_strain (double, every lane of a 4-lane group; padding lanes of
+// the last group compute zeros): 6 rows x 5 terms x (mul + add) = 60; per
+// tet, g(E) += s for its 6 edges (double).
+inline constexpr long kTetFormStrainPerLane = 60;
+inline constexpr long kTetFormStrainUpdates = 6;
 // edge_force_segment (edges in V0 segments), per edge: v = p~ g 3, acc += v 3,
 // f(b) -= v 3; per vertex: f(a) += acc 3.
 inline constexpr long kEdgeForce = 9;
@@ -78,6 +83,14 @@ inline Count edge_force(const Items& n, ModelKind kind) {
     Count c;
     c.counted = n.E * (kEdgeStrain + kEdgeForce) + n.V * kVertexForce;
     c.total = c.counted + (kind == ModelKind::FE ? n.P * kTsepStrainDouble + n.E * kSegmentStrainDouble : 0.0);
+    return c;
+}
+// FE forces with the tet-local form's g pass instead of the TSEP loop (the
+// serial operator's path when it holds the form: the default layout).
+inline Count edge_force_tet_local(const Items& n) {
+    Count c = edge_force(n, ModelKind::SN);  // the same counted arithmetic: strains and scatter
+    const double lanes = std::ceil(n.T / 4) * 4;
+    c.total = c.counted + lanes * kTetFormStrainPerLane + n.T * kTetFormStrainUpdates;
     return c;
 }
 // Edge-based stiffness (from the state of a force call).

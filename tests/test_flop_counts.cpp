@@ -34,6 +34,7 @@ TEST(FlopCounts, HandFormulasMatchTheCountingScalarExactly) {
         EXPECT_EQ(double(got.edge_stiffness_sn), flops::edge_stiffness(n, ModelKind::SN).counted);
         EXPECT_EQ(double(got.edge_kx), flops::edge_kx(n).counted);
         EXPECT_EQ(double(got.edge_stiffness_fe_tet_local), flops::edge_stiffness_tet_local(n).counted);
+        EXPECT_EQ(double(got.edge_force_fe_tet_local), flops::edge_force_tet_local(n).counted);
         // The counting scalar executes the energy arithmetic the source always
         // computes (with_energy = true).
         EXPECT_EQ(double(got.tet_force), flops::tet_force(n, true).counted);

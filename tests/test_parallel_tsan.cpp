@@ -55,27 +55,31 @@ TEST(ParallelTsan, EdgeKernels) {
     const auto models = edgefem::test::make_models<double>(mesh);
     const auto u = deformation_displacement(mesh, Deformation::Twist);
     const auto x = deformation_displacement(mesh, Deformation::Random);
-    for (Variant v : kAllVariants) {
-        std::vector<double> ref_f, ref_y, ref_D, ref_K;
-        for (int threads : {1, 3}) {
-            PlanOptions opts;
-            opts.owner_parts = 5;  // the owner variant's spill windows in use (every part spills)
-            ParallelEdgeKernels<double> k(models.edge, std::make_shared<ThreadExecutor>(threads), v, opts);
-            std::vector<double> f(u.size()), y(u.size()), D(3 * u.size());
-            EdgeState<double> st;
-            EdgeStiffness<double> K;
-            k.forces<ModelKind::FE, true>(u.data(), f.data(), st);
-            k.stiffness<ModelKind::FE, false>(st, K);
-            k.multiply(K, x.data(), y.data());
-            k.diagonal_blocks(K, D.data());
-            std::vector<double> Ke(K.K.begin(), K.K.begin() + 9 * std::size_t(models.edge.num_edges()));
-            if (threads == 1) {
-                ref_f = f, ref_y = y, ref_D = D, ref_K = Ke;
-            } else if (is_deterministic(v)) {
-                EXPECT_TRUE(same(f, ref_f) && same(y, ref_y) && same(D, ref_D) && same(Ke, ref_K)) << to_string(v);
-            } else {
-                EXPECT_LE(edgefem::test::rel_diff(f, ref_f), 1e-12);
-                EXPECT_LE(edgefem::test::rel_diff(Ke, ref_K), 1e-12);
+    const TetEdgeForm<double> form = make_tet_edge_form<double>(mesh, models.topo, Materials(Material{1e5, 0.3, 1000}));
+    for (bool tet_local : {false, true}) {  // with the form: its stiffness pass, and the owner variant's force from it
+        for (Variant v : kAllVariants) {
+            std::vector<double> ref_f, ref_y, ref_D, ref_K;
+            for (int threads : {1, 3}) {
+                PlanOptions opts;
+                opts.owner_parts = 5;  // the owner variant's spill windows in use (every part spills)
+                ParallelEdgeKernels<double> k(models.edge, std::make_shared<ThreadExecutor>(threads), v, opts,
+                                              tet_local ? form : TetEdgeForm<double>{});
+                std::vector<double> f(u.size()), y(u.size()), D(3 * u.size());
+                EdgeState<double> st;
+                EdgeStiffness<double> K;
+                k.forces<ModelKind::FE, true>(u.data(), f.data(), st);
+                k.stiffness<ModelKind::FE, false>(st, K);
+                k.multiply(K, x.data(), y.data());
+                k.diagonal_blocks(K, D.data());
+                std::vector<double> Ke(K.K.begin(), K.K.begin() + 9 * std::size_t(models.edge.num_edges()));
+                if (threads == 1) {
+                    ref_f = f, ref_y = y, ref_D = D, ref_K = Ke;
+                } else if (is_deterministic(v)) {
+                    EXPECT_TRUE(same(f, ref_f) && same(y, ref_y) && same(D, ref_D) && same(Ke, ref_K)) << to_string(v);
+                } else {
+                    EXPECT_LE(edgefem::test::rel_diff(f, ref_f), 1e-12);
+                    EXPECT_LE(edgefem::test::rel_diff(Ke, ref_K), 1e-12);
+                }
             }
         }
     }

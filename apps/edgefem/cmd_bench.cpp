@@ -16,6 +16,7 @@
 #include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
@@ -84,27 +85,34 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
 }
 
 // Bytes one call of `kernel` moves (compulsory and per-pass counts,
-// stream_bandwidth.hpp), from an edge model built for the purpose and freed
-// before the timed one is built; {0, 0} where no model applies (per-tet
+// stream_bandwidth.hpp), from an edge model (and form) built for the purpose
+// and freed before the timed calls; {0, 0} where no model applies (per-tet
 // method, stiffness, force+stiffness).
 struct Traffic {
     double compulsory = 0, per_pass = 0;
 };
 
+// `form_forces`: the force call takes g from the tet-local form
+// (Evaluator::forces_from_tet_local_form).
 template <class S>
-Traffic kernel_traffic_as(const BenchOptions& opts, const Mesh& mesh, Kernel kernel) {
+Traffic kernel_traffic_as(const BenchOptions& opts, const Mesh& mesh, Kernel kernel, bool form_forces) {
     const Topology topo = build_topology(mesh);
     const EdgeModel<S> m = make_edge_model<S>(topo, compute_coefficients(mesh, topo, opts.model.material));
+    if (kernel == Kernel::Force && form_forces) {
+        const TetEdgeForm<S> form = make_tet_edge_form<S>(mesh, topo, opts.model.material);
+        return {form_force_bytes_per_call(m, form, TrafficModel::Compulsory),
+                form_force_bytes_per_call(m, form, TrafficModel::PerPass)};
+    }
     if (kernel == Kernel::Force)
         return {force_bytes_per_call(m, opts.model.kind(), TrafficModel::Compulsory),
                 force_bytes_per_call(m, opts.model.kind(), TrafficModel::PerPass)};
     return {kx_bytes_per_call(m, TrafficModel::Compulsory), kx_bytes_per_call(m, TrafficModel::PerPass)};
 }
 
-Traffic kernel_traffic(const BenchOptions& opts, const Mesh& mesh, Kernel kernel) {
+Traffic kernel_traffic(const BenchOptions& opts, const Mesh& mesh, Kernel kernel, bool form_forces) {
     if (opts.model.method_kind() != Method::Edge || (kernel != Kernel::Force && kernel != Kernel::Kx)) return {};
-    return opts.model.precision_kind() == Precision::Float ? kernel_traffic_as<float>(opts, mesh, kernel)
-                                                           : kernel_traffic_as<double>(opts, mesh, kernel);
+    return opts.model.precision_kind() == Precision::Float ? kernel_traffic_as<float>(opts, mesh, kernel, form_forces)
+                                                           : kernel_traffic_as<double>(opts, mesh, kernel, form_forces);
 }
 
 void run_bench(const BenchOptions& opts) {
@@ -122,9 +130,9 @@ void run_bench(const BenchOptions& opts) {
     }
     const Kernel kernel = kKernels.at(opts.kernel);
     const Mesh& mesh = lm.mesh;
-    const Traffic traffic = kernel_traffic(opts, mesh, kernel);
-
     auto eval = make_evaluator(mesh, opts.model, opts.exec);
+    const Traffic traffic = kernel_traffic(opts, mesh, kernel, eval->forces_from_tet_local_form());
+
     eval->set_displacement(deformation_displacement(mesh, Deformation::Twist));
     // kx multiplies a generic (non-smooth) vector.
     eval->prepare(kernel, deformation_displacement(mesh, Deformation::Random));

@@ -54,6 +54,7 @@ public:
         escape(f_.data());
         escape(y_.data());
     }
+    bool forces_from_tet_local_form() const override { return op_->forces_from_tet_local_form(); }
 
 private:
     std::unique_ptr<ElasticOperator<S>> op_;

@@ -85,6 +85,7 @@ public:
     index_t inverted_tets(const S* u) const override {
         return count_inverted_tets_parallel(k_.executor(), mesh_, u);
     }
+    bool forces_from_tet_local_form() const override { return Kind == ModelKind::FE && k_.form_forces(); }
 
 private:
     static ParallelEdgeKernels<S> build_kernels(const Mesh& mesh, const Materials& materials,

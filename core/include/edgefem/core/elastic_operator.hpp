@@ -19,7 +19,9 @@ enum class Method { Edge, Tet };
 // Where the edge method's FE stiffness takes its pair terms from: the
 // per-tet 6x6 form (tet_edge_form.hpp; 2-3x faster, measured in
 // docs/layouts.md) or the mesh-wide TSEP list with its 4 targets per pair.
-// Forces always run the TSEP list. SN and the per-tet method ignore it.
+// With the tet-local form, core's serial forces (and the parallel owner
+// variant's) take g from the form too; the other parallel variants run the
+// TSEP list for the forces. SN and the per-tet method ignore it.
 enum class StiffnessLayout { TetLocal, TsepList };
 // "tet-local" | "tsep-list"; throws InvalidArgument otherwise.
 StiffnessLayout parse_stiffness_layout(const std::string& name);
@@ -48,6 +50,9 @@ public:
     virtual void for_each_block(void (*visit)(void*, index_t, index_t, const S*), void* ctx) const = 0;
     // Number of tets with non-positive volume at the last forces() call.
     virtual index_t inverted_tets(const S* u) const = 0;
+    // Whether forces() takes g(E) from the tet-local form rather than the
+    // TSEP list: which arrays a force call streams (stream_bandwidth.hpp).
+    virtual bool forces_from_tet_local_form() const { return false; }
 };
 
 // Throws InvalidArgument for SN with the per-tet method.

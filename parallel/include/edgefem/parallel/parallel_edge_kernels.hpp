@@ -75,6 +75,9 @@ public:
     // Tet-local stiffness only: the colouring of the form's batches.
     const Colouring& form_colouring() const { return form_col_; }
     bool tet_local_stiffness() const { return form_.num_tets > 0; }
+    // Owner variant: FE forces with g from the tet-local form
+    // (PlanOptions::form_forces).
+    bool form_forces() const { return form_forces_ && tet_local_stiffness() && variant_ == Variant::Owner; }
     // Bytes of the plan (colour lists, gather lists; private buffers once allocated).
     std::size_t plan_bytes() const;
 
@@ -105,6 +108,8 @@ private:
     // gather(v, incident edges, count, out) for vertex v, edge_to(i, add)
     // adding through add(k, value), and edge(i, out).
     void owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const;
+    void owner_form_forces(const S* u, S* f, EdgeState<S>& st) const;
+    void build_owner_form_parts();
     template <class Segment, class Gather, class EdgeTo, class Edge>
     void scatter_to_vertices(S* out, const Segment& segment, const Gather& gather, const EdgeTo& edge_to,
                              const Edge& edge) const;
@@ -128,6 +133,7 @@ private:
     index_t num_sinks_ = 1;  // sink blocks after the #E edge blocks
     Colouring vert_col_, tsep_col_, stiff_col_;
     TetEdgeForm<S> form_;  // empty: TSEP-list stiffness
+    bool form_forces_ = true;
     Colouring form_col_;
     // Gather lists: vertex -> incident edges (side-encoded), edge -> incoming
     // TSEPs (E0, L(P)), edge -> incoming stiffness contributions.
@@ -144,6 +150,12 @@ private:
     std::vector<index_t> corr_first_, corr_edges_;
     mutable std::vector<S> spill_v_, spill_d_;
     mutable std::vector<double> spill_g_;
+    // owner_form_forces: the form's batches of each part (those whose first
+    // tet's lowest vertex is in the part's vertices: every edge they write
+    // is at or past the part's first edge) and the g windows past its edges.
+    std::vector<index_t> form_batch_first_;
+    ForwardSpill fspill_;
+    mutable std::vector<double> spill_fg_;
     // Private accumulators (allocated on first use).
     mutable std::vector<S> pv_, pd_, pk_;
     mutable std::vector<double> pg_;
@@ -166,7 +178,8 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
       variant_(variant),
       range_chunk_(std::max<index_t>(1, opts.range_chunk)),
       parts_(std::max(1, ex_->threads())),
-      form_(std::move(form)) {
+      form_(std::move(form)),
+      form_forces_(opts.form_forces) {
     const index_t ne = m_.num_edges(), nv = m_.num_vertices;
     const index_t owner_parts = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv);
     if (variant_ == Variant::Auto) {
@@ -271,6 +284,7 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
             spill_v_.assign(3 * vspill_.spill_targets(), S(0));
             spill_d_.assign(9 * vspill_.spill_targets(), S(0));
             spill_g_.assign(espill_.spill_targets(), 0.0);
+            if (form_forces()) build_owner_form_parts();
             if (opts.stiffness && !m_.target.empty()) build_stiffness_sources();
             break;
         }
@@ -306,11 +320,11 @@ std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
     b += bytes(inc_first_) + bytes(inc_) + bytes(tin_first_) + bytes(tin_e0_) + bytes(tin_L_) + bytes(kin_first_) +
          bytes(kin_);
     b += bytes(pv_) + bytes(pd_) + bytes(pk_) + bytes(pg_);
-    for (const ForwardSpill* fs : {&vspill_, &espill_})
+    for (const ForwardSpill* fs : {&vspill_, &espill_, &fspill_})
         b += bytes(fs->part_first) + bytes(fs->window_end) + bytes(fs->window_first) + bytes(fs->in_first) +
              bytes(fs->in_part);
-    b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_) + bytes(corr_first_) +
-         bytes(corr_edges_);
+    b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_) + bytes(corr_first_) + bytes(corr_edges_) +
+         bytes(form_batch_first_) + bytes(spill_fg_);
     return b;
 }
 
@@ -342,7 +356,10 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
     const auto& m = m_;
     if constexpr (Kind == ModelKind::FE)
         if (variant_ == Variant::Owner) {
-            owner_fused_forces(u, f, st);
+            if (form_forces())
+                owner_form_forces(u, f, st);
+            else
+                owner_fused_forces(u, f, st);
             if constexpr (Energy)
                 return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
             return 0;
@@ -434,6 +451,83 @@ void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& 
                     kernel::edge_force_add(m, e, p, dg, f, fout);
                 }
                 break;
+            default:
+                add_incoming_spills<3>(vs, q, f, spill_v_);
+                break;
+        }
+    });
+}
+
+template <class S>
+void ParallelEdgeKernels<S>::build_owner_form_parts() {
+    const auto& m = m_;
+    const auto& f = form_;
+    constexpr int L = kTetLanes<S>;
+    const index_t P = vspill_.parts(), nb = f.num_batches(), ne = m.num_edges();
+    // Local edge 0 of a tet joins its two lowest vertices, V0 first.
+    const auto low_vertex = [&](index_t b) { return m.edge[f.edge[std::size_t(b) * 6 * L]][0]; };
+    form_batch_first_.assign(std::size_t(P) + 1, nb);
+    index_t b = 0;
+    for (index_t q = 0; q <= P; ++q) {
+        const index_t v = q < P ? vspill_.part_first[q] : m.num_vertices;
+        while (b < nb && low_vertex(b) < v) ++b;
+        form_batch_first_[q] = q == 0 ? 0 : b;
+    }
+    form_batch_first_[P] = nb;
+    // Each part's batches reach up to their largest edge: that is the
+    // window, anchored at the part's first edge.
+    std::vector<index_t> reach(static_cast<std::size_t>(ne));
+    for (index_t e = 0; e < ne; ++e) reach[e] = e;
+    for (index_t q = 0; q < P; ++q)
+        for (index_t bb = form_batch_first_[q]; bb < form_batch_first_[q + 1]; ++bb)
+            for (int k = 0; k < 6; ++k)
+                for (int l = 0; l < f.batch_size(bb); ++l) {
+                    const index_t e = f.edge[(std::size_t(bb) * 6 + k) * L + l];
+                    const index_t anchor = espill_.part_first[q];
+                    if (e < anchor) throw InvalidArgument("owner form parts: a batch writes an edge before its part");
+                    reach[anchor] = std::max(reach[anchor], e);
+                }
+    fspill_ = make_forward_spill(ne, espill_.part_first, [&reach](index_t e) { return reach[e]; });
+    spill_fg_.assign(fspill_.spill_targets(), 0.0);
+}
+
+// The owner variant's FE force with g from the tet-local form, in one region
+// of 4 phases over the parts (vertex parts, their edge segments, and the
+// form batches whose lowest vertex they hold): 0 strains of the part's
+// edges, f zeroed; 1 the part's batches add their terms to g, past the
+// part's edges into its window; 2 the incoming windows added to g (now
+// final), then the edge scatter of the part's vertex segments; 3 the
+// incoming f windows added. Sums in an order fixed by the parts: bitwise
+// the same for any thread count.
+template <class S>
+void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& st) const {
+    const auto& m = m_;
+    const ForwardSpill &vs = vspill_, &fs = fspill_;
+    S* p = st.p.data();
+    S* zeta = st.zeta.data();
+    double* g = st.g.data();
+    const index_t P = vs.parts();
+    const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
+    ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
+        const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
+        const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
+        switch (phase) {
+            case 0:
+                for (index_t i = eb; i < ee; ++i) kernel::edge_strain(m, u, i, p, zeta, g);
+                std::fill(f + 3 * std::size_t(vb), f + 3 * std::size_t(ve), S(0));
+                break;
+            case 1: {
+                const kernel::ForwardOut<double> gout{g, spill_fg_.data() + fs.window_first[q], ee};
+                for (index_t b = form_batch_first_[q]; b < form_batch_first_[q + 1]; ++b)
+                    kernel::tet_form_strain(form_, b, zeta, gout);
+                break;
+            }
+            case 2: {
+                add_incoming_spills<1>(fs, q, g, spill_fg_);
+                const kernel::ForwardOut<S> fout{f, spill_v_.data() + 3 * vs.window_first[q], ve};
+                for (index_t a = vb; a < ve; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
+                break;
+            }
             default:
                 add_incoming_spills<3>(vs, q, f, spill_v_);
                 break;

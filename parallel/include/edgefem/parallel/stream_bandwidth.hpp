@@ -21,6 +21,7 @@
 
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/executor.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 
 namespace edgefem {
 
@@ -127,6 +128,23 @@ double force_bytes_per_call(const EdgeModel<S>& m, ModelKind kind = ModelKind::F
         if (kind == ModelKind::FE) b += 2 * E * sizeof(double);
         b += 2 * (3 * V * s);
     }
+    return b;
+}
+
+// The same for an FE force call with g from the tet-local form
+// (tet_form_forces, the owner variant's owner_form_forces): the TSEP arrays
+// replaced by the form's edge ids and rows (every batch lane, padding
+// included); zeta is read again by the form pass. PerPass adds the edge
+// re-read by the scatter, the form pass's read-modify-write of g
+// (+2 #E double) and f's zero fill and scatter (+2 x 3 #V S).
+template <class S>
+double form_force_bytes_per_call(const EdgeModel<S>& m, const TetEdgeForm<S>& form,
+                                 TrafficModel model = TrafficModel::Compulsory) {
+    const auto bytes_of = [](const auto& v) { return detail::traffic_bytes_of(v); };
+    const double E = m.num_edges(), s = sizeof(S);
+    double b = force_bytes_per_call(m, ModelKind::SN, model);  // strains, scatter, p~ / zeta / g, u, f
+    b += bytes_of(form.edge) + bytes_of(form.A) + E * s;       // + zeta read by the form pass
+    if (model == TrafficModel::PerPass) b += 2 * E * sizeof(double);
     return b;
 }
 

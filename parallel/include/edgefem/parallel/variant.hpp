@@ -94,6 +94,12 @@ struct PlanOptions {
     // the colouring of the form's batches (kTetLanes tets; units of 8 batches).
     StiffnessLayout stiffness_layout = StiffnessLayout::TetLocal;
     ColouringOptions form_colouring = form_batch_colouring();
+    // With the tet-local form, the owner variant's FE forces take g from it
+    // too (owner parts of its batches) instead of the TSEP loop: 1.3-1.4x
+    // faster at 2 threads on bunny-4k to bunny-1m (docs/parallel.md). The
+    // colour variant keeps its TSEP segments: the form's batch colouring
+    // has more colours, and its barriers lost at 2 threads on armadillo-7k.
+    bool form_forces = true;
     index_t range_chunk = 2048;          // items per chunk of the uncoloured loops
     // Owner variant: the number of parts (consecutive vertices for the edge
     // scatter, consecutive edges for the TSEP loop, each balanced on the
