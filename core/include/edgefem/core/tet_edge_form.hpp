@@ -241,8 +241,12 @@ inline void scatter_blocks(const V (&kv)[9], S* const (&blk)[kTetLanes<S>]) {
 // Adds each tet's share of the 6 off-diagonal Hessian blocks, less the edge
 // terms, to K(E) (row-major 3x3 per edge, #E + 1 blocks: the last is the
 // sink) for batch b, from the current edge vectors p~ (3 #E).
-template <class S>
-inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __restrict p, S* __restrict K) {
+// With `Spill`, the blocks of edges >= end go to spill[9 (e - end)] (the
+// owner-computes parallel variant's window past its part); padding lanes
+// still write the sink block K(#E).
+template <bool Spill, class S>
+inline void tet_form_stiffness_impl(const TetEdgeForm<S>& f, index_t b, const S* __restrict p, S* __restrict K,
+                                    S* __restrict spill, index_t end) {
     constexpr int L = kTetLanes<S>;
     // One value per lane in a register: the blocks are scattered straight
     // from registers (a stack array written as vectors and re-read per lane
@@ -280,7 +284,13 @@ inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __re
         const int k0 = kVertexEdges[a][0], k1 = kVertexEdges[a][1], k2 = kVertexEdges[a][2];
         const S s0 = S(2 * kVertexSigns[a][0]), s1 = S(2 * kVertexSigns[a][1]), s2 = S(2 * kVertexSigns[a][2]);
         S* blk[L];
-        for (int l = 0; l < L; ++l) blk[l] = l < n ? &K[9 * std::size_t(E[e * L + l])] : sink;
+        for (int l = 0; l < L; ++l) {
+            const index_t t = E[e * L + l];
+            if constexpr (Spill)
+                blk[l] = l >= n ? sink : t < end ? &K[9 * std::size_t(t)] : &spill[9 * std::size_t(t - end)];
+            else
+                blk[l] = l < n ? &K[9 * std::size_t(t)] : sink;
+        }
         V kv[9];
         for (int i = 0; i < 3; ++i) {
             const V x0 = s0 * P[k0][i], x1 = s1 * P[k1][i], x2 = s2 * P[k2][i];
@@ -288,6 +298,14 @@ inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __re
         }
         scatter_blocks(kv, blk);
     }
+}
+template <class S>
+inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __restrict p, S* __restrict K) {
+    tet_form_stiffness_impl<false>(f, b, p, K, static_cast<S*>(nullptr), 0);
+}
+template <class S>
+inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __restrict p, const ForwardOut<S>& out) {
+    tet_form_stiffness_impl<true>(f, b, p, out.direct, out.spill, out.end);
 }
 
 }  // namespace kernel

@@ -150,12 +150,14 @@ private:
     std::vector<index_t> corr_first_, corr_edges_;
     mutable std::vector<S> spill_v_, spill_d_;
     mutable std::vector<double> spill_g_;
-    // owner_form_forces: the form's batches of each part (those whose first
-    // tet's lowest vertex is in the part's vertices: every edge they write
-    // is at or past the part's first edge) and the g windows past its edges.
+    // Owner variant with the tet-local form: the form's batches of each part
+    // (those whose first tet's lowest vertex is in the part's vertices:
+    // every edge they write is at or past the part's first edge) and the
+    // windows past its edges, for g (owner_form_forces) and K.
     std::vector<index_t> form_batch_first_;
     ForwardSpill fspill_;
     mutable std::vector<double> spill_fg_;
+    mutable std::vector<S> spill_fk_;  // owner stiffness from the form: K windows
     // Private accumulators (allocated on first use).
     mutable std::vector<S> pv_, pd_, pk_;
     mutable std::vector<double> pg_;
@@ -284,7 +286,7 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
             spill_v_.assign(3 * vspill_.spill_targets(), S(0));
             spill_d_.assign(9 * vspill_.spill_targets(), S(0));
             spill_g_.assign(espill_.spill_targets(), 0.0);
-            if (form_forces()) build_owner_form_parts();
+            if (tet_local_stiffness()) build_owner_form_parts();
             if (opts.stiffness && !m_.target.empty()) build_stiffness_sources();
             break;
         }
@@ -324,7 +326,7 @@ std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
         b += bytes(fs->part_first) + bytes(fs->window_end) + bytes(fs->window_first) + bytes(fs->in_first) +
              bytes(fs->in_part);
     b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_) + bytes(corr_first_) + bytes(corr_edges_) +
-         bytes(form_batch_first_) + bytes(spill_fg_);
+         bytes(form_batch_first_) + bytes(spill_fg_) + bytes(spill_fk_);
     return b;
 }
 
@@ -488,7 +490,8 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
                     reach[anchor] = std::max(reach[anchor], e);
                 }
     fspill_ = make_forward_spill(ne, espill_.part_first, [&reach](index_t e) { return reach[e]; });
-    spill_fg_.assign(fspill_.spill_targets(), 0.0);
+    if (form_forces()) spill_fg_.assign(fspill_.spill_targets(), 0.0);
+    spill_fk_.assign(9 * fspill_.spill_targets(), S(0));
 }
 
 // The owner variant's FE force with g from the tet-local form, in one region
@@ -550,6 +553,28 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
             for (index_t i = b; i < e; ++i) {
                 kernel::edge_stiffness<Definite>(m, i, p, g, K);
                 kernel::tsep_stiffness_gather(m, i, &kin_[kin_first_[i]], kin_first_[i + 1] - kin_first_[i], p, K);
+            }
+        });
+        return;
+    }
+    if (Kind == ModelKind::FE && tet_local_stiffness() && variant_ == Variant::Owner) {
+        // Owner parts of the form's batches (as owner_form_forces): 0 the
+        // edge terms of the part's edges, 1 its batches' pair terms, past
+        // its edges into its window, 2 the incoming windows added. Only the
+        // last part's last batch has padding lanes (they write the sink).
+        const ForwardSpill& fs = fspill_;
+        const index_t P = fs.parts();
+        const index_t phase_first[4] = {0, P, 2 * P, 3 * P};
+        ex_->for_phases(3, phase_first, [&](int phase, index_t q) {
+            const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
+            if (phase == 0) {
+                for (index_t i = eb; i < ee; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
+            } else if (phase == 1) {
+                const kernel::ForwardOut<S> kout{K, spill_fk_.data() + 9 * fs.window_first[q], ee};
+                for (index_t b = form_batch_first_[q]; b < form_batch_first_[q + 1]; ++b)
+                    kernel::tet_form_stiffness(form_, b, p, kout);
+            } else {
+                add_incoming_spills<9>(fs, q, K, spill_fk_);
             }
         });
         return;
