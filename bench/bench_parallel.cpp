@@ -14,9 +14,10 @@
 // (with the input numbering of the shared meshes the owner variant's spill
 // windows cover 1.6-37x the vertices); all rows see the same numbering.
 // The stiffness is the default tet-local layout (core/tet_edge_form.hpp) in
-// core's serial loop and in every variant (its pair terms are a coloured
-// scatter over tet batches whatever the variant; the variant decides the
-// per-edge terms only).
+// core's serial loop and in every variant (owner: owner parts of the form's
+// batches; the others: a coloured scatter over them; the variant decides the
+// per-edge terms). The FE force of core's serial loop and of the owner
+// variant takes g from the form too ($EDGEFEM_FORM_FORCES=0: the TSEP loop).
 #include <benchmark/benchmark.h>
 
 #include <chrono>

@@ -12,9 +12,12 @@
 // buffers). One object must not run two kernels at the same time.
 //
 // Given a tet-local form (tet_edge_form.hpp), the FE stiffness adds its pair
-// terms from it instead of the TSEP list, whatever the variant: as a
-// coloured scatter over batches of tets (no two batches of a colour write
-// the same K(E)), so the result is independent of the thread count.
+// terms from it instead of the TSEP list: in the owner variant over owner
+// parts of the form's batches with K windows past each part's edges (and
+// its FE forces take g from the form the same way, owner_form_forces); in
+// the others as a coloured scatter over batches (no two batches of a colour
+// write the same K(E)). Either way the result is independent of the thread
+// count.
 #pragma once
 
 #include <atomic>
