@@ -1,6 +1,9 @@
 // Memory orderings against each other: the edge force, stiffness and K x
 // kernels (double, 1 thread) after renumbering the vertices with each
-// ordering (edges and TSEPs follow). Names: <kernel>/<ordering>/<mesh>.
+// ordering (edges, TSEPs and the tet-local form's batches follow). The
+// force and stiffness are the FE operator's defaults: pair terms from the
+// tet-local form (tet_form_forces, tet_form_stiffness_all). Names:
+// <kernel>/<ordering>/<mesh>.
 // The partition issue's targets, on bunny-1m: best ordering >= 3x faster than
 // the random shuffle and >= 1.3x faster than input order for the force kernel.
 #include <benchmark/benchmark.h>
@@ -13,6 +16,7 @@
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 
@@ -22,6 +26,7 @@ namespace {
 
 struct Prepared {
     EdgeModel<double> model;
+    TetEdgeForm<double> form;
     std::vector<double> u, x;
     index_t tets;
 };
@@ -35,7 +40,10 @@ const Prepared& prepared(const std::string& mesh_name, Ordering o) {
         const Mesh mesh = permute_mesh(base, perm);
         const Topology topo = build_topology(mesh);
         p = std::make_unique<Prepared>();
-        p->model = make_edge_model<double>(topo, compute_coefficients(mesh, topo, Material{1e5, 0.3, 1000}));
+        const Materials mat(Material{1e5, 0.3, 1000});
+        p->model = make_edge_model<double>(topo, compute_coefficients(mesh, topo, mat));
+        p->model.target = {};  // the TSEP-list stiffness is not run
+        p->form = make_tet_edge_form<double>(mesh, topo, mat);
         p->u = deformation_displacement(mesh, Deformation::Twist);
         p->x.resize(p->u.size());
         for (std::size_t i = 0; i < p->x.size(); ++i) p->x[i] = std::sin(0.7 * i);
@@ -51,13 +59,13 @@ void BM_Ordered(benchmark::State& state, std::string mesh, Ordering o, Kernel k)
     std::vector<double> f(p.u.size()), y(p.u.size());
     EdgeState<double> st;
     EdgeStiffness<double> K;
-    edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st);
-    edge_stiffness_all<ModelKind::FE>(p.model, st, K);
+    tet_form_forces<ModelKind::FE, false>(p.model, p.form, p.u.data(), f.data(), st);
+    tet_form_stiffness_all<ModelKind::FE>(p.model, p.form, st, K);
     for (auto _ : state) {
         if (k == Kernel::Force)
-            edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st);
+            tet_form_forces<ModelKind::FE, false>(p.model, p.form, p.u.data(), f.data(), st);
         else if (k == Kernel::Stiffness)
-            edge_stiffness_all<ModelKind::FE>(p.model, st, K);
+            tet_form_stiffness_all<ModelKind::FE>(p.model, p.form, st, K);
         else
             edge_multiply(p.model, K, p.x.data(), y.data());
         benchmark::DoNotOptimize(f.data());

@@ -243,7 +243,15 @@ struct Simulator<S>::Impl {
     // A = c_m M + c_k K + c_b K0.
     void apply_system(double c_m, double c_k, double c_b, const double* in, double* out) {
         multiply(*op, in, out);
-        each([&](std::size_t i) { out[i] = c_m * mass[i / 3] * in[i] + c_k * out[i]; });
+        // Per vertex, scalars by value, restrict arrays: vectorises (a
+        // per-dof loop over mass[i / 3] with c_m, c_k by reference did not).
+        const double* __restrict m = mass.data();
+        const double* __restrict xin = in;
+        double* __restrict y = out;
+        each_vertex([=](std::size_t v) {
+            const double mv = c_m * m[v];
+            for (int k = 0; k < 3; ++k) y[3 * v + k] = mv * xin[3 * v + k] + c_k * y[3 * v + k];
+        });
         if (c_b != 0) {
             multiply(*op_damp, in, Ax.data());
             each([&](std::size_t i) { out[i] += c_b * Ax[i]; });
@@ -356,9 +364,12 @@ struct Simulator<S>::Impl {
         });
         res = conjugate_gradient(
             *exec, n(), free_dof.data(), [&](const double* in, double* out) { apply_system(c_m, c_k, c_b, in, out); },
-            [&](const double* r, double* z) {
-                each_vertex([&](std::size_t vtx) {
-                    const double* M = &Dinv[9 * vtx];
+            [&](const double* r_in, double* z_out) {
+                const double* __restrict r = r_in;
+                double* __restrict z = z_out;
+                const double* __restrict Minv = Dinv.data();
+                each_vertex([=](std::size_t vtx) {
+                    const double* M = &Minv[9 * vtx];
                     const double* rv = &r[3 * vtx];
                     for (int i = 0; i < 3; ++i) z[3 * vtx + i] = M[3 * i] * rv[0] + M[3 * i + 1] * rv[1] + M[3 * i + 2] * rv[2];
                 });
