@@ -136,6 +136,7 @@ struct Simulator<S>::Impl {
     std::unique_ptr<ElasticOperator<S>> op;
     std::unique_ptr<ElasticOperator<S>> op_damp;  // K frozen at the step start (implicit, beta > 0)
     std::vector<double> mass;                     // #V
+    std::vector<double> mass_dof;                 // 3 #V: mass per dof, for loops that vectorise
     std::vector<S> u, v, fext, f;                 // 3 #V
     std::vector<std::uint8_t> free_dof;           // 3 #V
     std::vector<index_t> con_vertex;              // fixed and prescribed vertices
@@ -189,6 +190,8 @@ struct Simulator<S>::Impl {
         const Mesh& mesh = scene.mesh;
         op = factory(mesh, scene.materials, scene.model, scene.method);
         mass = edgefem::lumped_mass(mesh, scene.materials);
+        mass_dof.resize(3 * mass.size());
+        for (std::size_t i = 0; i < mass_dof.size(); ++i) mass_dof[i] = mass[i / 3];
         const std::size_t nd = 3 * std::size_t(mesh.num_vertices());
         u.assign(nd, S(0));
         v.assign(nd, S(0));
@@ -214,7 +217,7 @@ struct Simulator<S>::Impl {
         x.resize(nd);
         b.resize(nd);
         Ax.resize(nd);
-        Dinv.resize(9 * std::size_t(mesh.num_vertices()));
+        Dinv.resize(9 * std::size_t(mesh.num_vertices()) + 1);  // + 1: the last 4-lane row read (preconditioner)
     }
 
     // External load h = load (M g + f_ext).
@@ -243,15 +246,12 @@ struct Simulator<S>::Impl {
     // A = c_m M + c_k K + c_b K0.
     void apply_system(double c_m, double c_k, double c_b, const double* in, double* out) {
         multiply(*op, in, out);
-        // Per vertex, scalars by value, restrict arrays: vectorises (a
-        // per-dof loop over mass[i / 3] with c_m, c_k by reference did not).
-        const double* __restrict m = mass.data();
+        // Mass per dof, scalars by value: vectorises (over mass[i / 3] with
+        // c_m, c_k by reference it did not).
+        const double* __restrict m = mass_dof.data();
         const double* __restrict xin = in;
         double* __restrict y = out;
-        each_vertex([=](std::size_t v) {
-            const double mv = c_m * m[v];
-            for (int k = 0; k < 3; ++k) y[3 * v + k] = mv * xin[3 * v + k] + c_k * y[3 * v + k];
-        });
+        each([=](std::size_t i) { y[i] = c_m * m[i] * xin[i] + c_k * y[i]; });
         if (c_b != 0) {
             multiply(*op_damp, in, Ax.data());
             each([&](std::size_t i) { out[i] += c_b * Ax[i]; });
@@ -368,10 +368,20 @@ struct Simulator<S>::Impl {
                 const double* __restrict r = r_in;
                 double* __restrict z = z_out;
                 const double* __restrict Minv = Dinv.data();
+                // z = Dinv r per vertex as rows times broadcasts in 4-lane
+                // vectors: Dinv is exactly symmetric (spd_inverse3), so its
+                // rows are its columns; lane 3 reads the next value (Dinv
+                // has one spare at the end) and is never stored.
+                typedef double V4 __attribute__((vector_size(32)));
                 each_vertex([=](std::size_t vtx) {
                     const double* M = &Minv[9 * vtx];
                     const double* rv = &r[3 * vtx];
-                    for (int i = 0; i < 3; ++i) z[3 * vtx + i] = M[3 * i] * rv[0] + M[3 * i + 1] * rv[1] + M[3 * i + 2] * rv[2];
+                    V4 m0, m1, m2;
+                    __builtin_memcpy(&m0, M, sizeof m0);
+                    __builtin_memcpy(&m1, M + 3, sizeof m1);
+                    __builtin_memcpy(&m2, M + 6, sizeof m2);
+                    const V4 zv = rv[0] * m0 + rv[1] * m1 + rv[2] * m2;
+                    for (int i = 0; i < 3; ++i) z[3 * vtx + i] = zv[i];
                 });
             },
             b.data(), x.data(), tolerance, scene.solver.cg_max_iterations, scene.solver.cg_fixed_iterations, cg);
