@@ -685,9 +685,7 @@ void ParallelEdgeKernels<S>::diagonal_blocks(const EdgeStiffness<S>& Ks, S* D) c
             break;
         case Variant::Colour:
             each_range(index_t(nd), [&](index_t b, index_t e) { std::fill(D + b, D + e, S(0)); });
-            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) {
-                for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) kernel::edge_diagonal(m, e, K, D);
-            });
+            par::for_colours(*ex_, vert_col_, [&](index_t a, index_t) { kernel::edge_diagonal_segment(m, a, K, D); });
             break;
         case Variant::Gather:
             each_range(nv, [&](index_t b, index_t e) {
