@@ -93,8 +93,9 @@ void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required
         ->check(CLI::IsMember({"double", "float"}))
         ->capture_default_str();
     cmd.add_option("--layout", opts.layout,
-                   "Where the edge FE stiffness takes its pair terms from: tet-local (per-tet 6x6 form) or "
-                   "tsep-list (the mesh-wide TSEP list); results agree to round-off")
+                   "Where the edge FE stiffness (and the forces of the serial and owner kernels) take their pair "
+                   "terms from: tet-local (per-tet 6x6 form) or tsep-list (the mesh-wide TSEP list); results agree "
+                   "to round-off")
         ->check(CLI::IsMember({"tet-local", "tsep-list"}))
         ->capture_default_str();
     auto* young = cmd.add_option("--young", opts.material.young, "Young's modulus (Pa)");
