@@ -110,6 +110,8 @@ private:
     // per-edge workers: segment(a, out[, fwd]) for the edges whose V0 is a,
     // gather(v, incident edges, count, out) for vertex v, edge_to(i, add)
     // adding through add(k, value), and edge(i, out).
+    template <class Middle>
+    void owner_force_phases(const S* u, S* f, EdgeState<S>& st, Middle&& middle) const;
     void owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const;
     void owner_form_forces(const S* u, S* f, EdgeState<S>& st) const;
     void build_owner_form_parts();
@@ -415,54 +417,6 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
     return 0;
 }
 
-// The owner variant's FE force in one region of 4 phases over the vertex
-// parts (the edge parts are the parts' edge segments): 0 strains of the
-// part's edges, f zeroed; 1 the fused TSEP + edge scatter of its segments
-// (kernel::tsep_force_segment), every edge with the g it has so far; 2 for
-// the edges that earlier parts' TSEPs write, their window terms added to g
-// and scattered (kernel::edge_force_add); 3 the incoming f windows added.
-// Every sum has an order fixed by the parts alone: bitwise the same for any
-// thread count.
-template <class S>
-void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const {
-    const auto& m = m_;
-    const ForwardSpill &vs = vspill_, &es = espill_;
-    S* p = st.p.data();
-    S* zeta = st.zeta.data();
-    double* g = st.g.data();
-    const index_t P = vs.parts();
-    const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
-    ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
-        const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
-        const index_t eb = es.part_first[q], ee = es.part_first[q + 1];
-        const kernel::ForwardOut<S> fout{f, spill_v_.data() + 3 * vs.window_first[q], ve};
-        switch (phase) {
-            case 0:
-                for (index_t i = eb; i < ee; ++i) kernel::edge_strain(m, u, i, p, zeta, g);
-                std::fill(f + 3 * std::size_t(vb), f + 3 * std::size_t(ve), S(0));
-                break;
-            case 1: {
-                const kernel::ForwardOut<double> gout{g, spill_g_.data() + es.window_first[q], ee};
-                for (index_t a = vb; a < ve; ++a)
-                    kernel::tsep_force_segment(m, a, p, zeta, g, f, gout, fout);
-                break;
-            }
-            case 2:
-                // Only the listed edges have non-zero window entries.
-                for (index_t k = corr_first_[q]; k < corr_first_[q + 1]; ++k) {
-                    const index_t e = corr_edges_[k];
-                    const double dg = take_incoming_spill(es, q, e, spill_g_);
-                    g[e] += dg;
-                    kernel::edge_force_add(m, e, p, dg, f, fout);
-                }
-                break;
-            default:
-                add_incoming_spills<3>(vs, q, f, spill_v_);
-                break;
-        }
-    });
-}
-
 template <class S>
 void ParallelEdgeKernels<S>::build_owner_form_parts() {
     const auto& m = m_;
@@ -497,46 +451,81 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
     spill_fk_.assign(9 * fspill_.spill_targets(), S(0));
 }
 
-// The owner variant's FE force with g from the tet-local form, in one region
-// of 4 phases over the parts (vertex parts, their edge segments, and the
-// form batches whose lowest vertex they hold): 0 strains of the part's
-// edges, f zeroed; 1 the part's batches add their terms to g, past the
-// part's edges into its window; 2 the incoming windows added to g (now
-// final), then the edge scatter of the part's vertex segments; 3 the
-// incoming f windows added. Sums in an order fixed by the parts: bitwise
-// the same for any thread count.
+// The owner variant's FE forces in one region of 4 phases over the parts
+// (vertex parts and their edge segments): 0 strains of the part's edges, f
+// zeroed; 1 and 2 `middle(phase, part, vertex range, edge range, fout)`,
+// f written through fout (the part's f window past its vertices); 3 the
+// incoming f windows added. Every sum has an order fixed by the parts alone:
+// bitwise the same for any thread count.
 template <class S>
-void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& st) const {
+template <class Middle>
+void ParallelEdgeKernels<S>::owner_force_phases(const S* u, S* f, EdgeState<S>& st, Middle&& middle) const {
     const auto& m = m_;
-    const ForwardSpill &vs = vspill_, &fs = fspill_;
-    S* p = st.p.data();
-    S* zeta = st.zeta.data();
-    double* g = st.g.data();
+    const ForwardSpill &vs = vspill_, &es = espill_;
     const index_t P = vs.parts();
     const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
     ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
         const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
-        const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
-        switch (phase) {
-            case 0:
-                for (index_t i = eb; i < ee; ++i) kernel::edge_strain(m, u, i, p, zeta, g);
-                std::fill(f + 3 * std::size_t(vb), f + 3 * std::size_t(ve), S(0));
-                break;
-            case 1: {
-                const kernel::ForwardOut<double> gout{g, spill_fg_.data() + fs.window_first[q], ee};
-                for (index_t b = form_batch_first_[q]; b < form_batch_first_[q + 1]; ++b)
-                    kernel::tet_form_strain(form_, b, zeta, gout);
-                break;
+        const index_t eb = es.part_first[q], ee = es.part_first[q + 1];
+        if (phase == 0) {
+            for (index_t i = eb; i < ee; ++i) kernel::edge_strain(m, u, i, st.p.data(), st.zeta.data(), st.g.data());
+            std::fill(f + 3 * std::size_t(vb), f + 3 * std::size_t(ve), S(0));
+        } else if (phase == 3) {
+            add_incoming_spills<3>(vs, q, f, spill_v_);
+        } else {
+            middle(phase, q, vb, ve, eb, ee, kernel::ForwardOut<S>{f, spill_v_.data() + 3 * vs.window_first[q], ve});
+        }
+    });
+}
+
+// With the TSEP list: 1 the fused TSEP + edge scatter of the part's segments
+// (kernel::tsep_force_segment), every edge with the g it has so far; 2 for
+// the edges that earlier parts' TSEPs write, their window terms added to g
+// and scattered (kernel::edge_force_add).
+template <class S>
+void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const {
+    const auto& m = m_;
+    const ForwardSpill& es = espill_;
+    const S* p = st.p.data();
+    const S* zeta = st.zeta.data();
+    double* g = st.g.data();
+    owner_force_phases(u, f, st, [&](int phase, index_t q, index_t vb, index_t ve, index_t, index_t ee,
+                                     const kernel::ForwardOut<S>& fout) {
+        if (phase == 1) {
+            const kernel::ForwardOut<double> gout{g, spill_g_.data() + es.window_first[q], ee};
+            for (index_t a = vb; a < ve; ++a) kernel::tsep_force_segment(m, a, p, zeta, g, f, gout, fout);
+        } else {
+            // Only the listed edges have non-zero window entries.
+            for (index_t k = corr_first_[q]; k < corr_first_[q + 1]; ++k) {
+                const index_t e = corr_edges_[k];
+                const double dg = take_incoming_spill(es, q, e, spill_g_);
+                g[e] += dg;
+                kernel::edge_force_add(m, e, p, dg, f, fout);
             }
-            case 2: {
-                add_incoming_spills<1>(fs, q, g, spill_fg_);
-                const kernel::ForwardOut<S> fout{f, spill_v_.data() + 3 * vs.window_first[q], ve};
-                for (index_t a = vb; a < ve; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
-                break;
-            }
-            default:
-                add_incoming_spills<3>(vs, q, f, spill_v_);
-                break;
+        }
+    });
+}
+
+// With the tet-local form (the parts also hold the form's batches whose
+// lowest vertex is theirs): 1 the part's batches add their terms to g, past
+// the part's edges into its window; 2 the incoming windows added to g (now
+// final), then the edge scatter of the part's vertex segments.
+template <class S>
+void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& st) const {
+    const auto& m = m_;
+    const ForwardSpill& fs = fspill_;
+    const S* p = st.p.data();
+    const S* zeta = st.zeta.data();
+    double* g = st.g.data();
+    owner_force_phases(u, f, st, [&](int phase, index_t q, index_t vb, index_t ve, index_t, index_t ee,
+                                     const kernel::ForwardOut<S>& fout) {
+        if (phase == 1) {
+            const kernel::ForwardOut<double> gout{g, spill_fg_.data() + fs.window_first[q], ee};
+            for (index_t b = form_batch_first_[q]; b < form_batch_first_[q + 1]; ++b)
+                kernel::tet_form_strain(form_, b, zeta, gout);
+        } else {
+            add_incoming_spills<1>(fs, q, g, spill_fg_);
+            for (index_t a = vb; a < ve; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
         }
     });
 }
