@@ -136,6 +136,16 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant
                          mesh.c_str(), int(vs.parts()), 100.0 * double(vs.spill_targets()) / std::max<index_t>(1, vs.items()),
                          100.0 * double(es.spill_targets()) / std::max<index_t>(1, es.items()),
                          100.0 * double(cur.k->corrected_edges()) / std::max<index_t>(1, es.items()));
+            const auto& fb = cur.k->form_batch_parts();
+            if (fb.size() > 1) {
+                index_t lo = fb[1] - fb[0], hi = lo;
+                for (std::size_t q = 1; q + 1 < fb.size(); ++q) {
+                    lo = std::min(lo, fb[q + 1] - fb[q]);
+                    hi = std::max(hi, fb[q + 1] - fb[q]);
+                }
+                std::fprintf(stderr, "%s owner parts of the tet-local form: %d to %d batches per part (of %d)\n",
+                             mesh.c_str(), int(lo), int(hi), int(fb.back()));
+            }
         }
         cur.key = key;
     }

@@ -72,6 +72,8 @@ public:
     // the TSEP loop (edges), with their spill windows.
     const ForwardSpill& vertex_parts() const { return vspill_; }
     const ForwardSpill& edge_parts() const { return espill_; }
+    // Owner variant with the tet-local form: batch offsets of its parts.
+    const std::vector<index_t>& form_batch_parts() const { return form_batch_first_; }
     // Edges of the owner FE force that receive g terms from earlier parts:
     // scattered with a correction after the barrier.
     index_t corrected_edges() const { return index_t(corr_edges_.size()); }
