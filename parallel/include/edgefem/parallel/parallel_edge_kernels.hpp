@@ -428,13 +428,12 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
     // Local edge 0 of a tet joins its two lowest vertices, V0 first.
     const auto low_vertex = [&](index_t b) { return m.edge[f.edge[std::size_t(b) * 6 * L]][0]; };
     form_batch_first_.assign(std::size_t(P) + 1, nb);
+    form_batch_first_[0] = 0;
     index_t b = 0;
-    for (index_t q = 0; q <= P; ++q) {
-        const index_t v = q < P ? vspill_.part_first[q] : m.num_vertices;
-        while (b < nb && low_vertex(b) < v) ++b;
-        form_batch_first_[q] = q == 0 ? 0 : b;
+    for (index_t q = 1; q < P; ++q) {
+        while (b < nb && low_vertex(b) < vspill_.part_first[q]) ++b;
+        form_batch_first_[q] = b;
     }
-    form_batch_first_[P] = nb;
     // Each part's batches reach up to their largest edge: that is the
     // window, anchored at the part's first edge.
     std::vector<index_t> reach(static_cast<std::size_t>(ne));
@@ -455,7 +454,7 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
 
 // The owner variant's FE forces in one region of 4 phases over the parts
 // (vertex parts and their edge segments): 0 strains of the part's edges, f
-// zeroed; 1 and 2 `middle(phase, part, vertex range, edge range, fout)`,
+// zeroed; 1 and 2 `middle(phase, part, vertex range, edge end, fout)`,
 // f written through fout (the part's f window past its vertices); 3 the
 // incoming f windows added. Every sum has an order fixed by the parts alone:
 // bitwise the same for any thread count.
@@ -475,7 +474,7 @@ void ParallelEdgeKernels<S>::owner_force_phases(const S* u, S* f, EdgeState<S>& 
         } else if (phase == 3) {
             add_incoming_spills<3>(vs, q, f, spill_v_);
         } else {
-            middle(phase, q, vb, ve, eb, ee, kernel::ForwardOut<S>{f, spill_v_.data() + 3 * vs.window_first[q], ve});
+            middle(phase, q, vb, ve, ee, kernel::ForwardOut<S>{f, spill_v_.data() + 3 * vs.window_first[q], ve});
         }
     });
 }
@@ -491,7 +490,7 @@ void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& 
     const S* p = st.p.data();
     const S* zeta = st.zeta.data();
     double* g = st.g.data();
-    owner_force_phases(u, f, st, [&](int phase, index_t q, index_t vb, index_t ve, index_t, index_t ee,
+    owner_force_phases(u, f, st, [&](int phase, index_t q, index_t vb, index_t ve, index_t ee,
                                      const kernel::ForwardOut<S>& fout) {
         if (phase == 1) {
             const kernel::ForwardOut<double> gout{g, spill_g_.data() + es.window_first[q], ee};
@@ -519,7 +518,7 @@ void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& s
     const S* p = st.p.data();
     const S* zeta = st.zeta.data();
     double* g = st.g.data();
-    owner_force_phases(u, f, st, [&](int phase, index_t q, index_t vb, index_t ve, index_t, index_t ee,
+    owner_force_phases(u, f, st, [&](int phase, index_t q, index_t vb, index_t ve, index_t ee,
                                      const kernel::ForwardOut<S>& fout) {
         if (phase == 1) {
             const kernel::ForwardOut<double> gout{g, spill_fg_.data() + fs.window_first[q], ee};
