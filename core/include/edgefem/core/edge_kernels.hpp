@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "edgefem/core/edge_model.hpp"
+#include "edgefem/core/kernel_inline.hpp"
 
 namespace edgefem {
 
@@ -45,7 +46,7 @@ namespace kernel {
 
 // Edge loop worker: p~(E), zeta(E) and g(E) = L(E) zeta(E).
 template <class S>
-inline void edge_strain(const EdgeModel<S>& m, const S* __restrict u, index_t e, S* __restrict p,
+EDGEFEM_KERNEL void edge_strain(const EdgeModel<S>& m, const S* __restrict u, index_t e, S* __restrict p,
                         S* __restrict zeta, double* __restrict g) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     const S* r = &m.rest[3 * std::size_t(e)];
@@ -73,7 +74,7 @@ struct ForwardOut {
     index_t end;
 };
 template <class T>
-inline ForwardOut<T> direct_only(T* out) {
+EDGEFEM_KERNEL ForwardOut<T> direct_only(T* out) {
     return {out, nullptr, std::numeric_limits<index_t>::max()};
 }
 // The first item of [first, last) whose target goes to the spill buffer
@@ -82,7 +83,7 @@ inline ForwardOut<T> direct_only(T* out) {
 // away. Found before the loops so that the main loop has no test in it (a
 // test inside measured 25-30 % slower in the latency-bound TSEP loop).
 template <class T, class Target>
-inline index_t spill_start(index_t first, index_t last, Target&& target, const ForwardOut<T>& out) {
+EDGEFEM_KERNEL index_t spill_start(index_t first, index_t last, Target&& target, const ForwardOut<T>& out) {
     if (out.end == std::numeric_limits<index_t>::max() || last == first || target(last - 1) < out.end) return last;
     index_t mid = first;
     while (target(mid) < out.end) ++mid;
@@ -91,12 +92,12 @@ inline index_t spill_start(index_t first, index_t last, Target&& target, const F
 // The row of target t (W values per target): in `direct` below `end`, else
 // in `spill`.
 template <int W, class T>
-inline T* forward_row(const ForwardOut<T>& out, index_t t) {
+EDGEFEM_KERNEL T* forward_row(const ForwardOut<T>& out, index_t t) {
     return t < out.end ? out.direct + W * std::size_t(t) : out.spill + W * std::size_t(t - out.end);
 }
 // body(i, row of target(i)) for i in [first, last), W values per target.
 template <int W, class T, class Target, class Body>
-inline void for_segment(index_t first, index_t last, Target&& target, const ForwardOut<T>& out, Body&& body) {
+EDGEFEM_KERNEL void for_segment(index_t first, index_t last, Target&& target, const ForwardOut<T>& out, Body&& body) {
     const index_t mid = spill_start(first, last, target, out);
     for (index_t i = first; i < mid; ++i) body(i, out.direct + W * std::size_t(target(i)));
     for (index_t i = mid; i < last; ++i) body(i, out.spill + W * std::size_t(target(i) - out.end));
@@ -106,7 +107,7 @@ inline void for_segment(index_t first, index_t last, Target&& target, const Forw
 // pair adds L(P) zeta(E1) to g(E0) and L(P) zeta(E0) to g(E1). The E1 of a
 // segment are distinct and greater than e0, so nothing inside it aliases.
 template <class S>
-inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g,
+EDGEFEM_KERNEL void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g,
                                 const ForwardOut<double>& out) {
     // Written out instead of through for_segment, with the split point found
     // first: this loop is bound by the latency of its g updates, and with a
@@ -132,13 +133,13 @@ inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __re
     g[e0] += acc;
 }
 template <class S>
-inline void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g) {
+EDGEFEM_KERNEL void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict zeta, double* __restrict g) {
     tsep_strain_segment(m, e0, zeta, g, direct_only(g));
 }
 
 // Edge scatter worker: f(V0) += p~ g, f(V1) -= p~ g.
 template <class S>
-inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, const double* __restrict g,
+EDGEFEM_KERNEL void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, const double* __restrict g,
                        S* __restrict f) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     for (int r = 0; r < 3; ++r) {
@@ -152,7 +153,7 @@ inline void edge_force(const EdgeModel<S>& m, index_t e, const S* __restrict p, 
 // f(V1) at fb. Shared by edge_force_segment and the fused
 // tsep_force_segment, which must stay bitwise equal.
 template <class S>
-inline void edge_force_terms(const S* __restrict p, index_t e, S gs, S& acc0, S& acc1, S& acc2, S* fb) {
+EDGEFEM_KERNEL void edge_force_terms(const S* __restrict p, index_t e, S gs, S& acc0, S& acc1, S& acc2, S* fb) {
     const S v0 = p[3 * std::size_t(e)] * gs, v1 = p[3 * std::size_t(e) + 1] * gs, v2 = p[3 * std::size_t(e) + 2] * gs;
     acc0 += v0;
     acc1 += v1;
@@ -166,7 +167,7 @@ inline void edge_force_terms(const S* __restrict p, index_t e, S gs, S& acc0, S&
 // segment's sum from registers (edges are sorted by V0, so a per-edge
 // f(V0) += ... would chain stores to one address); each f(V1) -= p~ g.
 template <class S>
-inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
+EDGEFEM_KERNEL void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
                                S* __restrict f, const ForwardOut<S>& out) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
     for_segment<3>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, out,
@@ -176,7 +177,7 @@ inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
     f[3 * std::size_t(a) + 2] += acc2;
 }
 template <class S>
-inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
+EDGEFEM_KERNEL void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
                                S* __restrict f) {
     edge_force_segment(m, a, p, g, f, direct_only(f));
 }
@@ -199,7 +200,7 @@ inline void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
 // but bunny-250k 9-12 % and box-1200 / bunny-4k 3-5 % slower; the sum over
 // zeta(E1) in a loop of its own before the g updates, 1.25-1.4x slower.
 template <class S>
-inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const S* __restrict zeta,
+EDGEFEM_KERNEL void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const S* __restrict zeta,
                                double* __restrict g, S* __restrict f) {
     const index_t* __restrict first = m.tsep_first.data();
     const index_t* __restrict other = m.tsep_other.data();
@@ -230,7 +231,7 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
 // here, and the rest with edge_force_add once the windows are in (the force
 // is linear in g).
 template <class S>
-inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const S* __restrict zeta,
+EDGEFEM_KERNEL void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const S* __restrict zeta,
                                double* __restrict g, S* __restrict f, const ForwardOut<double>& gout,
                                const ForwardOut<S>& fout) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
@@ -247,7 +248,7 @@ inline void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S* __rest
 // f(V0) += p~ dg with V0 inside the part, f(V1) -= p~ dg through `fout`:
 // the rest of an edge's scatter when its g grew by dg.
 template <class S>
-inline void edge_force_add(const EdgeModel<S>& m, index_t e, const S* __restrict p, double dg, S* __restrict f,
+EDGEFEM_KERNEL void edge_force_add(const EdgeModel<S>& m, index_t e, const S* __restrict p, double dg, S* __restrict f,
                            const ForwardOut<S>& fout) {
     const index_t a = m.edge[e][0];
     S* fb = forward_row<3>(fout, m.edge[e][1]);
@@ -263,7 +264,7 @@ inline void edge_force_add(const EdgeModel<S>& m, index_t e, const S* __restrict
 // semi-definite) plus the edge Laplacian weighted by g, so only edges with
 // g < 0 can make K indefinite (formulation.md section 5; forces unchanged).
 template <bool Definite = false, class S>
-inline void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict p, const double* __restrict g,
+EDGEFEM_KERNEL void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict p, const double* __restrict g,
                            S* __restrict K) {
     const S* q = &p[3 * std::size_t(e)];
     S* k = &K[9 * std::size_t(e)];
@@ -279,7 +280,7 @@ inline void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict
 // or (p1, p0) when transposed, picked by indexing, not by a branch. (A
 // scratch Kp written then re-read as vectors stalled on store forwarding.)
 template <class S>
-inline void tsep_stiffness_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict p, S* __restrict K) {
+EDGEFEM_KERNEL void tsep_stiffness_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict p, S* __restrict K) {
     const S* p0 = &p[3 * std::size_t(e0)];
     for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
         const S* p1 = &p[3 * std::size_t(m.tsep_other[P])];
@@ -304,7 +305,7 @@ inline void tsep_stiffness_segment(const EdgeModel<S>& m, index_t e0, const S* _
 
 // Matrix-free K x worker: d = x(V0) - x(V1); y(V0) -= K(E) d; y(V1) += K(E)^T d.
 template <class S>
-inline void edge_kx(const EdgeModel<S>& m, index_t e, const S* __restrict K, const S* __restrict x,
+EDGEFEM_KERNEL void edge_kx(const EdgeModel<S>& m, index_t e, const S* __restrict K, const S* __restrict x,
                     S* __restrict y) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     const S* k = &K[9 * std::size_t(e)];
@@ -344,7 +345,7 @@ struct Xyz4 {
 // vectors: K(E)^T d as three row-times-broadcast FMAs, K(E) d as lane-wise
 // products summed once per segment (half the scalar version's operations).
 template <class S>
-inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
+EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
                             S* __restrict y, const ForwardOut<S>& out) {
     const auto V1 = [&m](index_t e) { return m.edge[e][1]; };
     if constexpr (std::is_floating_point_v<S>) {
@@ -388,14 +389,14 @@ inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restric
     }
 }
 template <class S>
-inline void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
+EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
                             S* __restrict y) {
     edge_kx_segment(m, a, K, x, y, direct_only(y));
 }
 
 // Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
 template <class S>
-inline void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict K, S* __restrict D) {
+EDGEFEM_KERNEL void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict K, S* __restrict D) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     const S* k = &K[9 * std::size_t(e)];
     for (int i = 0; i < 3; ++i)
@@ -411,7 +412,7 @@ inline void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict 
 // edge to the same block: edge_diagonal_blocks was 4-5 % of an armadillo-7k
 // step).
 template <class S>
-inline void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D,
+EDGEFEM_KERNEL void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D,
                                   const ForwardOut<S>& out) {
     S acc[9] = {};
     for_segment<9>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, out,
@@ -427,7 +428,7 @@ inline void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __r
     for (int q = 0; q < 9; ++q) da[q] -= acc[q];
 }
 template <class S>
-inline void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D) {
+EDGEFEM_KERNEL void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D) {
     edge_diagonal_segment(m, a, K, D, direct_only(D));
 }
 

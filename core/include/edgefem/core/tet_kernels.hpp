@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "edgefem/core/kernel_inline.hpp"
 #include "edgefem/core/tet_model.hpp"
 
 namespace edgefem {
@@ -36,7 +37,7 @@ struct TetDeformation {
 };
 
 template <class S>
-inline void tet_deformation(const TetModel<S>& m, index_t t, const S* __restrict u, TetDeformation<S>& out) {
+EDGEFEM_KERNEL void tet_deformation(const TetModel<S>& m, index_t t, const S* __restrict u, TetDeformation<S>& out) {
     const auto& v = m.tet[t];
     const auto& d = m.data[t];
     S D[3][3];  // column c: u(v_{c+1}) - u(v_0)
@@ -62,7 +63,7 @@ inline void tet_deformation(const TetModel<S>& m, index_t t, const S* __restrict
 
 // Gradients a_0..a_3 of the tet's barycentric coordinates.
 template <class S>
-inline void tet_grads(const TetData<S>& d, S a[4][3]) {
+EDGEFEM_KERNEL void tet_grads(const TetData<S>& d, S a[4][3]) {
     for (int c = 0; c < 3; ++c) {
         a[1][c] = d.Dinv[0][c];
         a[2][c] = d.Dinv[1][c];
@@ -73,7 +74,7 @@ inline void tet_grads(const TetData<S>& d, S a[4][3]) {
 
 // Forces of one tet scattered into f; returns its energy.
 template <class S>
-inline S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict f) {
+EDGEFEM_KERNEL S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict f) {
     TetDeformation<S> def;
     tet_deformation(m, t, u, def);
     S P[3][3];
@@ -98,7 +99,7 @@ inline S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __
 // K_ab = (a_a . S a_b) I + lambda (F a_a)(F a_b)^T + mu (a_a . a_b) F F^T + mu (F a_b)(F a_a)^T
 // (all volume-scaled), from dP = dF S + F dS with dS = lambda tr(dG) I + 2 mu dG.
 template <class S>
-inline void tet_stiffness(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict Kt) {
+EDGEFEM_KERNEL void tet_stiffness(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict Kt) {
     TetDeformation<S> def;
     tet_deformation(m, t, u, def);
     const auto& d = m.data[t];
@@ -129,7 +130,7 @@ inline void tet_stiffness(const TetModel<S>& m, index_t t, const S* __restrict u
 
 // y += K_t x for one tet from its stored blocks.
 template <class S>
-inline void tet_kx(const TetModel<S>& m, index_t t, const S* __restrict Kt, const S* __restrict x, S* __restrict y) {
+EDGEFEM_KERNEL void tet_kx(const TetModel<S>& m, index_t t, const S* __restrict Kt, const S* __restrict x, S* __restrict y) {
     const auto& v = m.tet[t];
     for (int i = 0; i < 4; ++i) {
         S acc[3] = {0, 0, 0};
@@ -150,7 +151,7 @@ inline void tet_kx(const TetModel<S>& m, index_t t, const S* __restrict Kt, cons
 // y += K_t(u) x for one tet without stored blocks: dF = dDx Dm^-1,
 // dP = dF S + F dS, y_i += dP a_i.
 template <class S>
-inline void tet_kx_matrix_free(const TetModel<S>& m, index_t t, const S* __restrict u, const S* __restrict x,
+EDGEFEM_KERNEL void tet_kx_matrix_free(const TetModel<S>& m, index_t t, const S* __restrict u, const S* __restrict x,
                                S* __restrict y) {
     TetDeformation<S> def;
     tet_deformation(m, t, u, def);
