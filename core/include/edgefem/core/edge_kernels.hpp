@@ -39,6 +39,9 @@ struct EdgeState {
 template <class S>
 struct EdgeStiffness {
     std::vector<S> K;  // 9 (#E + 1)
+    // Padded copies of x and y (4 per vertex) for edge_multiply and the
+    // parallel K x: scratch, so one multiply at a time per EdgeStiffness.
+    mutable std::vector<S> x4, y4;
     void resize(index_t num_edges) { K.assign(9 * (static_cast<std::size_t>(num_edges) + 1), S(0)); }
 };
 
@@ -344,18 +347,33 @@ struct Xyz4 {
 // registers, as in edge_force_segment). Built-in scalars run it in 4-lane
 // vectors: K(E)^T d as three row-times-broadcast FMAs, K(E) d as lane-wise
 // products summed once per segment (half the scalar version's operations).
-template <class S>
+// W is the stride of x and y: 3 (xyz) or 4 (xyz and a pad lane, the
+// padded scratch of edge_multiply and the owner variant: one vector load
+// per x(V1) and one load + store per y(V1), instead of building and
+// splitting a 3-lane vector; the pad lane of y collects garbage and is never
+// read back).
+template <int W = 3, class S>
 EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
-                            S* __restrict y, const ForwardOut<S>& out) {
-    const auto V1 = [&m](index_t e) { return m.edge[e][1]; };
+                                    S* __restrict y, const ForwardOut<S>& out) {
+    static_assert(W == 3 || W == 4, "x and y hold 3 or 4 values per vertex");
+    // The edge list through a local restrict pointer: through m, g++ reloads
+    // its data pointer after every y store (it may alias).
+    const std::array<index_t, 2>* __restrict edge = m.edge.data();
+    const auto V1 = [edge](index_t e) { return edge[e][1]; };
     if constexpr (std::is_floating_point_v<S>) {
         using X = Xyz4<S>;
         using V = typename X::V;
-        const V xa = X::load(&x[3 * std::size_t(a)]);
+        const auto load = [](const S* p) {
+            if constexpr (W == 4)
+                return X::row(p);
+            else
+                return X::load(p);
+        };
+        const V xa = load(&x[W * std::size_t(a)]);
         V r0 = {}, r1 = {}, r2 = {};
-        for_segment<3>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
+        for_segment<W>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
             const S* k = &K[9 * std::size_t(e)];
-            const V d = xa - X::load(&x[3 * std::size_t(m.edge[e][1])]);
+            const V d = xa - load(&x[W * std::size_t(edge[e][1])]);
             const V k0 = X::row(k), k1 = X::row(k + 3), k2 = X::row(k + 6);
             r0 += k0 * d;
             r1 += k1 * d;
@@ -363,19 +381,25 @@ EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* _
             // y(V1) is summed into last: its chain through memory (the next
             // segment often updates the same vertex) stays one add long.
             const V t = d[0] * k0 + d[1] * k1 + d[2] * k2;
-            X::store(yb, X::load(yb) + t);
+            if constexpr (W == 4) {
+                const V s = X::row(yb) + t;
+                __builtin_memcpy(yb, &s, sizeof s);
+            } else {
+                X::store(yb, X::load(yb) + t);
+            }
         });
-        S* ya = &y[3 * std::size_t(a)];
+        S* ya = &y[W * std::size_t(a)];
         ya[0] -= r0[0] + r0[1] + r0[2];
         ya[1] -= r1[0] + r1[1] + r1[2];
         ya[2] -= r2[0] + r2[1] + r2[2];
     } else {
-        const S xa0 = x[3 * std::size_t(a)], xa1 = x[3 * std::size_t(a) + 1], xa2 = x[3 * std::size_t(a) + 2];
+        const S xa0 = x[W * std::size_t(a)], xa1 = x[W * std::size_t(a) + 1], xa2 = x[W * std::size_t(a) + 2];
         S acc0 = 0, acc1 = 0, acc2 = 0;
-        for_segment<3>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
-            const index_t b = m.edge[e][1];
+        for_segment<W>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
+            const index_t b = edge[e][1];
             const S* k = &K[9 * std::size_t(e)];
-            const S d0 = xa0 - x[3 * std::size_t(b)], d1 = xa1 - x[3 * std::size_t(b) + 1], d2 = xa2 - x[3 * std::size_t(b) + 2];
+            const S d0 = xa0 - x[W * std::size_t(b)], d1 = xa1 - x[W * std::size_t(b) + 1],
+                    d2 = xa2 - x[W * std::size_t(b) + 2];
             acc0 += k[0] * d0 + k[1] * d1 + k[2] * d2;
             acc1 += k[3] * d0 + k[4] * d1 + k[5] * d2;
             acc2 += k[6] * d0 + k[7] * d1 + k[8] * d2;
@@ -383,15 +407,35 @@ EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* _
             yb[1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
             yb[2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
         });
-        y[3 * std::size_t(a)] -= acc0;
-        y[3 * std::size_t(a) + 1] -= acc1;
-        y[3 * std::size_t(a) + 2] -= acc2;
+        y[W * std::size_t(a)] -= acc0;
+        y[W * std::size_t(a) + 1] -= acc1;
+        y[W * std::size_t(a) + 2] -= acc2;
+    }
+}
+template <int W = 3, class S>
+EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
+                                    S* __restrict y) {
+    edge_kx_segment<W>(m, a, K, x, y, direct_only(y));
+}
+
+// x (3 per vertex) into the padded x4 (4 per vertex, pad 0) and back, for
+// vertices [begin, end).
+template <class S>
+EDGEFEM_KERNEL void pad_xyz(const S* __restrict x, S* __restrict x4, index_t begin, index_t end) {
+    for (index_t v = begin; v < end; ++v) {
+        x4[4 * std::size_t(v)] = x[3 * std::size_t(v)];
+        x4[4 * std::size_t(v) + 1] = x[3 * std::size_t(v) + 1];
+        x4[4 * std::size_t(v) + 2] = x[3 * std::size_t(v) + 2];
+        x4[4 * std::size_t(v) + 3] = S(0);
     }
 }
 template <class S>
-EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
-                            S* __restrict y) {
-    edge_kx_segment(m, a, K, x, y, direct_only(y));
+EDGEFEM_KERNEL void unpad_xyz(const S* __restrict x4, S* __restrict x, index_t begin, index_t end) {
+    for (index_t v = begin; v < end; ++v) {
+        x[3 * std::size_t(v)] = x4[4 * std::size_t(v)];
+        x[3 * std::size_t(v) + 1] = x4[4 * std::size_t(v) + 1];
+        x[3 * std::size_t(v) + 2] = x4[4 * std::size_t(v) + 2];
+    }
 }
 
 // Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
@@ -467,11 +511,30 @@ void edge_stiffness_all(const EdgeModel<S>& m, const EdgeState<S>& st, EdgeStiff
         for (index_t e = 0; e < ne; ++e) kernel::tsep_stiffness_segment(m, e, st.p.data(), K.K.data());
 }
 
-// y = K x (3 #V, overwritten).
+// y = K x (3 #V, overwritten). Built-in scalars run on padded copies of x
+// and y in K's scratch (edge_kx_segment<4>): y(a) is final once segment a
+// has run (later segments only write vertices past their own), so it is
+// copied out right there. Bitwise the same as on xyz strides; armadillo-7k,
+// 1 thread: 3.77 -> 3.45 ns per edge, the copies included (the kernel alone
+// on padded vectors: 2.7). The owner variant keeps xyz strides: the copies
+// need a third phase, and its barrier made K x at 2 threads 1.3x slower.
 template <class S>
 void edge_multiply(const EdgeModel<S>& m, const EdgeStiffness<S>& K, const S* x, S* y) {
-    std::fill(y, y + 3 * std::size_t(m.num_vertices), S(0));
-    for (index_t a = 0; a < m.num_vertices; ++a) kernel::edge_kx_segment(m, a, K.K.data(), x, y);
+    const index_t nv = m.num_vertices;
+    if constexpr (std::is_floating_point_v<S>) {
+        K.x4.resize(4 * std::size_t(nv));
+        K.y4.assign(4 * std::size_t(nv), S(0));
+        S* __restrict x4 = K.x4.data();
+        S* __restrict y4 = K.y4.data();
+        kernel::pad_xyz(x, x4, 0, nv);
+        for (index_t a = 0; a < nv; ++a) {
+            kernel::edge_kx_segment<4>(m, a, K.K.data(), x4, y4);
+            kernel::unpad_xyz(y4, y, a, a + 1);
+        }
+    } else {
+        std::fill(y, y + 3 * std::size_t(nv), S(0));
+        for (index_t a = 0; a < nv; ++a) kernel::edge_kx_segment(m, a, K.K.data(), x, y);
+    }
 }
 
 // The 3x3 diagonal blocks of K (9 #V, row-major, overwritten).
