@@ -63,6 +63,15 @@ EDGEFEM_KERNEL void edge_strain(const EdgeModel<S>& m, const S* __restrict u, in
     g[e] = m.LE[e] * z;
 }
 
+// V1 of edge e through a local restrict pointer to the edge list: read
+// through m inside a segment loop, g++ reloads the vector's data pointer
+// after every store to a target row (it may alias).
+template <class S>
+EDGEFEM_KERNEL auto second_vertex(const EdgeModel<S>& m) {
+    const std::array<index_t, 2>* __restrict edge = m.edge.data();
+    return [edge](index_t e) { return edge[e][1]; };
+}
+
 // Where the segment kernels below write their forward targets (E1 > e0 of
 // a TSEP segment, V1 > a of a vertex segment): targets below `end` in
 // `direct` (indexed by target), the others in `spill` (indexed by target -
@@ -173,7 +182,7 @@ template <class S>
 EDGEFEM_KERNEL void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
                                S* __restrict f, const ForwardOut<S>& out) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
-    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, out,
+    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], second_vertex(m), out,
                    [&](index_t e, S* fb) { edge_force_terms(p, e, S(g[e]), acc0, acc1, acc2, fb); });
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
@@ -208,6 +217,7 @@ EDGEFEM_KERNEL void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S
     const index_t* __restrict first = m.tsep_first.data();
     const index_t* __restrict other = m.tsep_other.data();
     const S* __restrict LP = m.LP.data();
+    const auto V1 = second_vertex(m);
     S acc0 = 0, acc1 = 0, acc2 = 0;
     for (index_t e = m.edge_first[a]; e < m.edge_first[a + 1]; ++e) {
         const double z0 = zeta[e];
@@ -220,7 +230,7 @@ EDGEFEM_KERNEL void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S
         }
         const double ge = g[e] + s;
         g[e] = ge;
-        edge_force_terms(p, e, S(ge), acc0, acc1, acc2, f + 3 * std::size_t(m.edge[e][1]));
+        edge_force_terms(p, e, S(ge), acc0, acc1, acc2, f + 3 * std::size_t(V1(e)));
     }
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
@@ -238,7 +248,7 @@ EDGEFEM_KERNEL void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S
                                double* __restrict g, S* __restrict f, const ForwardOut<double>& gout,
                                const ForwardOut<S>& fout) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
-    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, fout,
+    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], second_vertex(m), fout,
                    [&](index_t e, S* fb) {
                        tsep_strain_segment(m, e, zeta, g, gout);
                        edge_force_terms(p, e, S(g[e]), acc0, acc1, acc2, fb);
@@ -356,10 +366,7 @@ template <int W = 3, class S>
 EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
                                     S* __restrict y, const ForwardOut<S>& out) {
     static_assert(W == 3 || W == 4, "x and y hold 3 or 4 values per vertex");
-    // The edge list through a local restrict pointer: through m, g++ reloads
-    // its data pointer after every y store (it may alias).
-    const std::array<index_t, 2>* __restrict edge = m.edge.data();
-    const auto V1 = [edge](index_t e) { return edge[e][1]; };
+    const auto V1 = second_vertex(m);
     if constexpr (std::is_floating_point_v<S>) {
         using X = Xyz4<S>;
         using V = typename X::V;
@@ -373,7 +380,7 @@ EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* _
         V r0 = {}, r1 = {}, r2 = {};
         for_segment<W>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
             const S* k = &K[9 * std::size_t(e)];
-            const V d = xa - load(&x[W * std::size_t(edge[e][1])]);
+            const V d = xa - load(&x[W * std::size_t(V1(e))]);
             const V k0 = X::row(k), k1 = X::row(k + 3), k2 = X::row(k + 6);
             r0 += k0 * d;
             r1 += k1 * d;
@@ -396,7 +403,7 @@ EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* _
         const S xa0 = x[W * std::size_t(a)], xa1 = x[W * std::size_t(a) + 1], xa2 = x[W * std::size_t(a) + 2];
         S acc0 = 0, acc1 = 0, acc2 = 0;
         for_segment<W>(m.edge_first[a], m.edge_first[a + 1], V1, out, [&](index_t e, S* yb) {
-            const index_t b = edge[e][1];
+            const index_t b = V1(e);
             const S* k = &K[9 * std::size_t(e)];
             const S d0 = xa0 - x[W * std::size_t(b)], d1 = xa1 - x[W * std::size_t(b) + 1],
                     d2 = xa2 - x[W * std::size_t(b) + 2];
@@ -459,7 +466,7 @@ template <class S>
 EDGEFEM_KERNEL void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D,
                                   const ForwardOut<S>& out) {
     S acc[9] = {};
-    for_segment<9>(m.edge_first[a], m.edge_first[a + 1], [&m](index_t e) { return m.edge[e][1]; }, out,
+    for_segment<9>(m.edge_first[a], m.edge_first[a + 1], second_vertex(m), out,
                    [&](index_t e, S* db) {
                        const S* k = &K[9 * std::size_t(e)];
                        for (int i = 0; i < 3; ++i)
