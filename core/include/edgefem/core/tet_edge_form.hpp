@@ -14,7 +14,8 @@
 // Layout: tets in batches of kTetLanes<S>, structure-of-arrays inside a batch,
 // so the per-tet arithmetic runs across the batch's tets in SIMD lanes;
 // tets sorted by their vertices, so neighbouring tets update neighbouring
-// K(E) blocks.
+// K(E) blocks (with the lanes of 16 consecutive batches interleaved, so the
+// tets of one batch rarely share an edge).
 // Each tet's vertices are taken in ascending global order, so every local
 // edge (i < j) runs the way its global edge does (V0 < V1): no transposes.
 #pragma once
@@ -60,7 +61,8 @@ struct TetEdgeForm {
     // A[(b * kFormRows + kSym[k][l]) * kTetLanes<S> + lane].
     std::vector<S> A;
     // The tet in each slot (batch * kTetLanes<S> + lane), for inspection only:
-    // the kernels never read it. Tets are stored sorted by their vertices.
+    // the kernels never read it. Tets are stored sorted by their vertices,
+    // the lanes of 16 consecutive batches interleaved (tet_edge_form.cpp).
     std::vector<index_t> slot_tet;
 
     index_t num_batches() const { return (num_tets + kTetLanes<S> - 1) / kTetLanes<S>; }
