@@ -162,6 +162,10 @@ private:
     // every edge they write is at or past the part's first edge) and the
     // windows past its edges, for g (owner_form_forces) and K.
     std::vector<index_t> form_batch_first_;
+    // Per part, the first of its batches that writes past the part's edges:
+    // the batches before it run the plain kernels (no window test per
+    // update).
+    std::vector<index_t> form_spill_first_;
     ForwardSpill fspill_;
     mutable std::vector<double> spill_fg_;
     mutable std::vector<S> spill_fk_;  // owner stiffness from the form: K windows
@@ -333,7 +337,7 @@ std::size_t ParallelEdgeKernels<S>::plan_bytes() const {
         b += bytes(fs->part_first) + bytes(fs->window_end) + bytes(fs->window_first) + bytes(fs->in_first) +
              bytes(fs->in_part);
     b += bytes(spill_v_) + bytes(spill_d_) + bytes(spill_g_) + bytes(corr_first_) + bytes(corr_edges_) +
-         bytes(form_batch_first_) + bytes(spill_fg_) + bytes(spill_fk_);
+         bytes(form_batch_first_) + bytes(form_spill_first_) + bytes(spill_fg_) + bytes(spill_fk_);
     return b;
 }
 
@@ -438,15 +442,19 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
     // window, anchored at the part's first edge.
     std::vector<index_t> reach(static_cast<std::size_t>(ne));
     for (index_t e = 0; e < ne; ++e) reach[e] = e;
-    for (index_t q = 0; q < P; ++q)
+    form_spill_first_.assign(std::size_t(P), 0);
+    for (index_t q = 0; q < P; ++q) {
+        const index_t anchor = espill_.part_first[q], end = espill_.part_first[q + 1];
+        form_spill_first_[q] = form_batch_first_[q + 1];
         for (index_t bb = form_batch_first_[q]; bb < form_batch_first_[q + 1]; ++bb)
             for (int k = 0; k < 6; ++k)
                 for (int l = 0; l < f.batch_size(bb); ++l) {
                     const index_t e = f.edge[(std::size_t(bb) * 6 + k) * L + l];
-                    const index_t anchor = espill_.part_first[q];
                     if (e < anchor) throw InvalidArgument("owner form parts: a batch writes an edge before its part");
                     reach[anchor] = std::max(reach[anchor], e);
+                    if (e >= end) form_spill_first_[q] = std::min(form_spill_first_[q], bb);
                 }
+    }
     fspill_ = make_forward_spill(ne, espill_.part_first, [&reach](index_t e) { return reach[e]; });
     if (form_forces()) spill_fg_.assign(fspill_.spill_targets(), 0.0);
     spill_fk_.assign(9 * fspill_.spill_targets(), S(0));
@@ -522,7 +530,8 @@ void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& s
                                      const kernel::ForwardOut<S>& fout) {
         if (phase == 1) {
             const kernel::ForwardOut<double> gout{g, spill_fg_.data() + fs.window_first[q], ee};
-            for (index_t b = form_batch_first_[q]; b < form_batch_first_[q + 1]; ++b)
+            for (index_t b = form_batch_first_[q]; b < form_spill_first_[q]; ++b) kernel::tet_form_strain(form_, b, zeta, g);
+            for (index_t b = form_spill_first_[q]; b < form_batch_first_[q + 1]; ++b)
                 kernel::tet_form_strain(form_, b, zeta, gout);
         } else {
             add_incoming_spills<1>(fs, q, g, spill_fg_);
@@ -564,7 +573,9 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
                 for (index_t i = eb; i < ee; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
             } else if (phase == 1) {
                 const kernel::ForwardOut<S> kout{K, spill_fk_.data() + 9 * fs.window_first[q], ee};
-                for (index_t b = form_batch_first_[q]; b < form_batch_first_[q + 1]; ++b)
+                for (index_t b = form_batch_first_[q]; b < form_spill_first_[q]; ++b)
+                    kernel::tet_form_stiffness(form_, b, p, K);
+                for (index_t b = form_spill_first_[q]; b < form_batch_first_[q + 1]; ++b)
                     kernel::tet_form_stiffness(form_, b, p, kout);
             } else {
                 add_incoming_spills<9>(fs, q, K, spill_fk_);
