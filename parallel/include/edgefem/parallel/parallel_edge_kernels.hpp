@@ -561,17 +561,19 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
     }
     if (Kind == ModelKind::FE && tet_local_stiffness() && variant_ == Variant::Owner) {
         // Owner parts of the form's batches (as owner_form_forces): 0 the
-        // edge terms of the part's edges, 1 its batches' pair terms, past
-        // its edges into its window, 2 the incoming windows added. Only the
-        // last part's last batch has padding lanes (they write the sink).
+        // edge terms of the part's edges, then its batches' pair terms,
+        // past its edges into its window (no other part writes the part's
+        // own blocks in this phase, so no barrier between the two; a third
+        // phase cost a barrier per build); 1 the incoming windows added.
+        // Only the last part's last batch has padding lanes (they write the
+        // sink).
         const ForwardSpill& fs = fspill_;
         const index_t P = fs.parts();
-        const index_t phase_first[4] = {0, P, 2 * P, 3 * P};
-        ex_->for_phases(3, phase_first, [&](int phase, index_t q) {
+        const index_t phase_first[3] = {0, P, 2 * P};
+        ex_->for_phases(2, phase_first, [&](int phase, index_t q) {
             const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
             if (phase == 0) {
                 for (index_t i = eb; i < ee; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
-            } else if (phase == 1) {
                 const kernel::ForwardOut<S> kout{K, spill_fk_.data() + 9 * fs.window_first[q], ee};
                 for (index_t b = form_batch_first_[q]; b < form_spill_first_[q]; ++b)
                     kernel::tet_form_stiffness(form_, b, p, K);
