@@ -39,8 +39,8 @@ struct EdgeState {
 template <class S>
 struct EdgeStiffness {
     std::vector<S> K;  // 9 (#E + 1)
-    // Padded copies of x and y (4 per vertex) for edge_multiply and the
-    // parallel K x: scratch, so one multiply at a time per EdgeStiffness.
+    // Padded copies of x and y (4 per vertex) for edge_multiply: scratch,
+    // so one edge_multiply at a time per EdgeStiffness.
     mutable std::vector<S> x4, y4;
     void resize(index_t num_edges) { K.assign(9 * (static_cast<std::size_t>(num_edges) + 1), S(0)); }
 };
@@ -358,10 +358,9 @@ struct Xyz4 {
 // vectors: K(E)^T d as three row-times-broadcast FMAs, K(E) d as lane-wise
 // products summed once per segment (half the scalar version's operations).
 // W is the stride of x and y: 3 (xyz) or 4 (xyz and a pad lane, the
-// padded scratch of edge_multiply and the owner variant: one vector load
-// per x(V1) and one load + store per y(V1), instead of building and
-// splitting a 3-lane vector; the pad lane of y collects garbage and is never
-// read back).
+// padded scratch of edge_multiply: one vector load per x(V1) and one
+// load + store per y(V1), instead of building and splitting a 3-lane
+// vector; the pad lane of y collects garbage and is never read back).
 template <int W = 3, class S>
 EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, const S* __restrict x,
                                     S* __restrict y, const ForwardOut<S>& out) {
