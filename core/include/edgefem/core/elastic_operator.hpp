@@ -42,6 +42,9 @@ public:
     // semi-definite, the forces are unchanged.
     virtual void build_stiffness(bool definite) = 0;
     // y = K x with the K of the last build_stiffness (3 #V, overwritten).
+    // One call at a time per operator, like every other member: the kernels
+    // keep scratch in the operator (padded copies, spill windows), const or
+    // not.
     virtual void multiply(const S* x, S* y) const = 0;
     // The 3x3 diagonal blocks of K (9 #V, row-major, overwritten).
     virtual void diagonal_blocks(S* D) const = 0;
