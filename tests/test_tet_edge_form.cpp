@@ -1,9 +1,15 @@
 // The tet-local form against the mesh-wide TSEP list: the same g(E), forces,
 // energy and per-edge K(E) blocks to round-off (1e-12 double, 1e-5 float),
-// on every test mesh and deformation, plain and definite tangent.
+// on every test mesh and deformation, plain and definite tangent. And the
+// serial sweeps' tiles: any tile size gives bitwise the results of one
+// whole-mesh tile (three plain passes), in any vertex numbering.
 #include <gtest/gtest.h>
 
+#include <numeric>
+#include <random>
+
 #include "edgefem/core/deformations.hpp"
+#include "edgefem/core/error.hpp"
 #include "edgefem/core/tet_edge_form.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
@@ -70,4 +76,79 @@ TEST(TetEdgeForm, EdgesAreTheTetsEdges) {
             for (int r = 0; r < kFormRows; ++r)
                 ASSERT_EQ(form.A[(t / kTetLanes<double> * kFormRows + r) * kTetLanes<double> + t % kTetLanes<double>], 0.0) << name;
     }
+}
+
+
+namespace {
+
+// The mesh with its vertices renumbered at random: edges then reach far
+// across the numbering, the hardest case for the tiles' bounds.
+Mesh shuffled(const Mesh& mesh, unsigned seed) {
+    std::vector<index_t> to(mesh.num_vertices());
+    std::iota(to.begin(), to.end(), index_t(0));
+    std::mt19937 rng(seed);
+    std::shuffle(to.begin(), to.end(), rng);
+    Mesh s;
+    s.X.resize(mesh.X.size());
+    for (index_t v = 0; v < mesh.num_vertices(); ++v)
+        for (int c = 0; c < 3; ++c) s.X[3 * std::size_t(to[v]) + c] = mesh.X[3 * std::size_t(v) + c];
+    s.tets = mesh.tets;
+    for (auto& v : s.tets) v = to[v];
+    s.region = mesh.region;
+    return s;
+}
+
+template <class S>
+void tiles_bitwise(const Mesh& mesh, const std::string& name) {
+    const Materials mat(Material{1e5, 0.3, 1000});
+    const auto m = test::make_models<S>(mesh, mat);
+    TetEdgeForm<S> form = make_tet_edge_form<S>(mesh, m.topo, mat);
+    const auto u = test::cast<S>(deformation_displacement(mesh, Deformation::Random));
+    // Reference: one tile, the whole mesh.
+    form.tiles.clear();
+    std::vector<S> f0(u.size());
+    EdgeState<S> s0;
+    EdgeStiffness<S> K0;
+    const double W0 = tet_form_forces<ModelKind::FE, true>(m.edge, form, u.data(), f0.data(), s0);
+    tet_form_stiffness_all<ModelKind::FE, false>(m.edge, form, s0, K0);
+    for (index_t per_tile : {1, 3, 64, kFormTileBatches, form.num_batches() + 1}) {
+        SCOPED_TRACE(name + ", " + std::to_string(per_tile) + " batches per tile");
+        form.tiles = plan_form_tiles(form, m.topo.edges, m.topo.first_edge, per_tile);
+        ASSERT_FALSE(form.tiles.empty());
+        const FormTile& last = form.tiles.back();
+        EXPECT_EQ(last.batch_end, form.num_batches());
+        EXPECT_EQ(last.edge_end, m.edge.num_edges());
+        EXPECT_EQ(last.vertex_end, m.edge.num_vertices);
+        EXPECT_EQ(last.zero_end, m.edge.num_vertices);
+        // Garbage in f first: the tiles must zero every entry they scatter to.
+        std::vector<S> f1(u.size(), S(7));
+        EdgeState<S> s1;
+        EdgeStiffness<S> K1;
+        const double W1 = tet_form_forces<ModelKind::FE, true>(m.edge, form, u.data(), f1.data(), s1);
+        tet_form_stiffness_all<ModelKind::FE, false>(m.edge, form, s1, K1);
+        EXPECT_TRUE(f1 == f0);
+        EXPECT_TRUE(s1.g == s0.g);
+        EXPECT_TRUE(K1.K == K0.K);
+        EXPECT_EQ(W1, W0);
+    }
+}
+
+}  // namespace
+
+TEST(TetEdgeForm, TilesAreBitwiseTheWholeMeshPasses) {
+    for (const auto& [name, mesh] : test::test_meshes(10000)) {
+        tiles_bitwise<double>(mesh, name);
+        tiles_bitwise<double>(shuffled(mesh, 7), name + " shuffled");
+        tiles_bitwise<float>(mesh, name);
+    }
+}
+
+TEST(TetEdgeForm, TilePlanRejectsNonsense) {
+    const auto meshes = test::test_meshes(10000);
+    const Mesh& mesh = meshes.front().mesh;
+    const auto m = test::make_models<double>(mesh, Materials(Material{}));
+    const auto form = make_tet_edge_form<double>(mesh, m.topo, Materials(Material{}));
+    EXPECT_THROW(plan_form_tiles(form, m.topo.edges, m.topo.first_edge, 0), InvalidArgument);
+    std::vector<index_t> short_first(m.topo.first_edge.begin(), m.topo.first_edge.end() - 1);
+    EXPECT_THROW(plan_form_tiles(form, m.topo.edges, short_first, 16), InvalidArgument);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <numeric>
+#include <string>
 
 #include "edgefem/core/error.hpp"
 
@@ -77,12 +78,69 @@ TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const 
             for (int m = k + 1; m < 6; ++m) f.A[(b * kFormRows + kSym[k][m]) * L + lane] = S(A[k][m]);
         }
     }
+    f.tiles = plan_form_tiles(f, topo.edges, topo.first_edge, kFormTileBatches);
     return f;
+}
+
+template <class S>
+std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vector<std::array<index_t, 2>>& edges,
+                                      const std::vector<index_t>& first_edge, index_t batches_per_tile) {
+    if (batches_per_tile < 1) throw InvalidArgument("plan_form_tiles: batches_per_tile must be >= 1");
+    if (first_edge.empty() || first_edge.front() != 0 || first_edge.back() != index_t(edges.size()))
+        throw InvalidArgument("plan_form_tiles: first_edge does not match the edge list");
+    constexpr int L = kTetLanes<S>;
+    const index_t nb = form.num_batches(), nv = index_t(first_edge.size()) - 1, ne = index_t(edges.size());
+    for (index_t v = 0; v < nv; ++v) {
+        if (first_edge[v + 1] < first_edge[v])
+            throw InvalidArgument("plan_form_tiles: first_edge decreases at vertex " + std::to_string(v));
+        for (index_t e = first_edge[v]; e < first_edge[v + 1]; ++e)
+            if (e < 0 || e >= ne || edges[e][0] != v || edges[e][1] <= v || edges[e][1] >= nv)
+                throw InvalidArgument("plan_form_tiles: edge " + std::to_string(e) +
+                                      " is not listed under its V0 or its V1 is out of range");
+    }
+    // Per batch: the lowest V0 of its edges (its tets' lowest vertex) and
+    // its largest edge id; real lanes only (padding lanes are never written).
+    std::vector<index_t> low(nb), high(nb);
+    for (index_t b = 0; b < nb; ++b) {
+        index_t lo = nv, hi = 0;
+        for (int k = 0; k < 6; ++k)
+            for (int l = 0; l < form.batch_size(b); ++l) {
+                const index_t e = form.edge[(std::size_t(b) * 6 + k) * L + l];
+                if (e < 0 || e >= ne) throw InvalidArgument("plan_form_tiles: the form indexes an edge out of range");
+                lo = std::min(lo, edges[e][0]);
+                hi = std::max(hi, e + 1);
+            }
+        low[b] = lo;
+        high[b] = hi;
+    }
+    std::vector<index_t> low_after(std::size_t(nb) + 1, nv);  // lowest V0 of the batches from b on
+    for (index_t b = nb; b-- > 0;) low_after[b] = std::min(low_after[b + 1], low[b]);
+    std::vector<FormTile> tiles;
+    index_t edge_end = 0, zero_end = 0, vertex_end = 0, scanned = 0;
+    for (index_t b0 = 0; b0 < nb || tiles.empty(); b0 += batches_per_tile) {
+        const index_t b1 = std::min(nb, b0 + batches_per_tile);
+        for (index_t b = b0; b < b1; ++b) edge_end = std::max(edge_end, high[b]);
+        // Segments below the next tiles' lowest vertex have all their batches.
+        vertex_end = std::max(vertex_end, b1 == nb ? nv : low_after[b1]);
+        edge_end = std::max(edge_end, first_edge[vertex_end]);  // the scatter reads their p~
+        // The scatter writes f(V1) of those segments' edges: zeroed first.
+        for (; scanned < first_edge[vertex_end]; ++scanned) zero_end = std::max(zero_end, edges[scanned][1] + 1);
+        zero_end = std::max(zero_end, vertex_end);
+        tiles.push_back({b1, b1 == nb ? ne : edge_end, vertex_end, b1 == nb ? nv : zero_end});
+        if (b1 == nb) break;
+    }
+    return tiles;
 }
 
 template struct TetEdgeForm<double>;
 template struct TetEdgeForm<float>;
 template TetEdgeForm<double> make_tet_edge_form<double>(const Mesh&, const Topology&, const Materials&);
 template TetEdgeForm<float> make_tet_edge_form<float>(const Mesh&, const Topology&, const Materials&);
+template std::vector<FormTile> plan_form_tiles<double>(const TetEdgeForm<double>&,
+                                                       const std::vector<std::array<index_t, 2>>&,
+                                                       const std::vector<index_t>&, index_t);
+template std::vector<FormTile> plan_form_tiles<float>(const TetEdgeForm<float>&,
+                                                      const std::vector<std::array<index_t, 2>>&,
+                                                      const std::vector<index_t>&, index_t);
 
 }  // namespace edgefem

@@ -63,6 +63,17 @@ EDGEFEM_KERNEL void edge_strain(const EdgeModel<S>& m, const S* __restrict u, in
     g[e] = m.LE[e] * z;
 }
 
+// The edge loop over edges [e0, e1), out of line and scalar
+// (EDGEFEM_SCALAR_LOOP says why).
+template <class S>
+EDGEFEM_SCALAR_LOOP void edge_strain_range(const EdgeModel<S>& m, const S* __restrict u, index_t e0, index_t e1,
+                                           S* __restrict p, S* __restrict zeta, double* __restrict g) {
+#if defined(__clang__)
+#pragma clang loop vectorize(disable)
+#endif
+    for (index_t e = e0; e < e1; ++e) edge_strain(m, u, e, p, zeta, g);
+}
+
 // V1 of edge e through a local restrict pointer to the edge list: read
 // through m inside a segment loop, g++ reloads the vector's data pointer
 // after every store to a target row (it may alias).
@@ -493,7 +504,7 @@ template <ModelKind Kind, bool Energy, class S>
 double edge_forces(const EdgeModel<S>& m, const S* u, S* f, EdgeState<S>& st) {
     const index_t ne = m.num_edges();
     st.resize(ne);
-    for (index_t e = 0; e < ne; ++e) kernel::edge_strain(m, u, e, st.p.data(), st.zeta.data(), st.g.data());
+    kernel::edge_strain_range(m, u, 0, ne, st.p.data(), st.zeta.data(), st.g.data());
     std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
     if constexpr (Kind == ModelKind::FE)
         for (index_t a = 0; a < m.num_vertices; ++a)

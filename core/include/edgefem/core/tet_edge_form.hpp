@@ -20,6 +20,8 @@
 // edge (i < j) runs the way its global edge does (V0 < V1): no transposes.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
 #include <type_traits>
 #include <vector>
@@ -51,6 +53,22 @@ inline constexpr int kSym[6][6] = {{15, 0, 1, 2, 3, 4},  {0, 15, 5, 6, 7, 8},   
 inline constexpr int kVertexEdges[4][3] = {{0, 1, 2}, {0, 3, 4}, {1, 3, 5}, {2, 4, 5}};
 inline constexpr int kVertexSigns[4][3] = {{1, 1, 1}, {-1, 1, 1}, {-1, -1, 1}, {-1, -1, -1}};
 
+// One tile of the serial sweeps (tet_form_forces, tet_form_stiffness_all).
+// Tile i runs the edge loop up to edge edge_end, the batches up to
+// batch_end, then (forces) zeroes f up to vertex zero_end and scatters the
+// vertex segments up to vertex_end. Its batches touch only edges below
+// edge_end, and an edge's g is final once every batch whose lowest vertex is
+// at most its V0 has run, so each value is computed from the same inputs in
+// the same order as by three whole-mesh passes: the results are bitwise
+// equal, but on meshes larger than the cache a tile's p~, zeta and g (or
+// K(E)) are still cached when the next pass reads them.
+// bench: bunny-1m force 23-26 -> 19-21 ns/tet at 1024 batches per tile
+// (256: 21-22; 16384: 20-21; whole mesh: 23-32); bunny-4k unchanged.
+struct FormTile {
+    index_t batch_end, edge_end, vertex_end, zero_end;
+};
+inline constexpr index_t kFormTileBatches = 1024;
+
 template <class S>
 struct TetEdgeForm {
     index_t num_tets = 0;
@@ -64,6 +82,8 @@ struct TetEdgeForm {
     // the kernels never read it. Tets are stored sorted by their vertices,
     // the lanes of 16 consecutive batches interleaved (tet_edge_form.cpp).
     std::vector<index_t> slot_tet;
+    // The serial sweeps' tiles (FormTile); empty: one tile, the whole mesh.
+    std::vector<FormTile> tiles;
 
     index_t num_batches() const { return (num_tets + kTetLanes<S> - 1) / kTetLanes<S>; }
     index_t batch_size(index_t b) const { return std::min<index_t>(kTetLanes<S>, num_tets - b * kTetLanes<S>); }
@@ -82,12 +102,21 @@ TetEdgeForm<To> convert_scalar(const TetEdgeForm<From>& f) {
     c.edge = f.edge;
     c.A.assign(f.A.begin(), f.A.end());
     c.slot_tet = f.slot_tet;
+    c.tiles = f.tiles;
     return c;
 }
 
-// Throws InvalidArgument for an invalid material.
+// Throws InvalidArgument for an invalid material. The tiles are planned
+// with kFormTileBatches batches each.
 template <class S>
 TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const Materials& materials);
+
+// Tiles of `batches_per_tile` batches (>= 1) for `form` over the edge list
+// its edge ids index: {V0, V1} per edge, sorted by V0, with first_edge[v]
+// the first edge whose V0 is v (as in Topology).
+template <class S>
+std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vector<std::array<index_t, 2>>& edges,
+                                      const std::vector<index_t>& first_edge, index_t batches_per_tile);
 
 namespace kernel {
 
@@ -315,22 +344,41 @@ inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __re
 // ---- Serial loops: edge_forces / edge_stiffness_all with the TSEP loop
 // replaced by the tet-local form (same results up to summation order). ----
 
-// The g pass and the scatter were also tried fused in one sweep over the
-// vertices (a vertex's edges are final once the batches starting at or below
-// it have run): 5-10 % slower on bunny-4k and armadillo-7k (bench_kernels,
-// three runs), so the three loops stay.
+// Runs `body(tile, e0, b0, a0, z0)` for each tile (FormTile) with the ends
+// of the previous one, the whole mesh as one tile when the form has none.
+template <class S, class Body>
+void for_form_tiles(const TetEdgeForm<S>& form, index_t num_edges, index_t num_vertices, Body&& body) {
+    const FormTile whole{form.num_batches(), num_edges, num_vertices, num_vertices};
+    const FormTile* t = form.tiles.empty() ? &whole : form.tiles.data();
+    const std::size_t n = form.tiles.empty() ? 1 : form.tiles.size();
+    FormTile prev{0, 0, 0, 0};
+    for (std::size_t i = 0; i < n; ++i) {
+        body(t[i], prev);
+        prev = t[i];
+    }
+}
+
+// The three passes (edge loop, g pass over the batches, edge scatter) run
+// tile by tile (FormTile). The g pass and the scatter were also tried fused
+// in one sweep over the vertices: 5-10 % slower on bunny-4k and
+// armadillo-7k (bench_kernels, three runs).
 template <ModelKind Kind, bool Energy, class S>
 double tet_form_forces(const EdgeModel<S>& m, const TetEdgeForm<S>& form, const S* u, S* f, EdgeState<S>& st) {
-    const index_t ne = m.num_edges();
-    st.resize(ne);
-    for (index_t e = 0; e < ne; ++e) kernel::edge_strain(m, u, e, st.p.data(), st.zeta.data(), st.g.data());
-    if constexpr (Kind == ModelKind::FE)
-        for (index_t b = 0; b < form.num_batches(); ++b) kernel::tet_form_strain(form, b, st.zeta.data(), st.g.data());
-    std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
-    for (index_t a = 0; a < m.num_vertices; ++a) kernel::edge_force_segment(m, a, st.p.data(), st.g.data(), f);
+    st.resize(m.num_edges());
+    S* p = st.p.data();
+    S* zeta = st.zeta.data();
+    double* g = st.g.data();
     double W = 0;
-    if constexpr (Energy)
-        for (index_t e = 0; e < ne; ++e) W += double(st.zeta[e]) * st.g[e];
+    for_form_tiles(form, m.num_edges(), m.num_vertices, [&](const FormTile& t, const FormTile& prev) {
+        kernel::edge_strain_range(m, u, prev.edge_end, t.edge_end, p, zeta, g);
+        if constexpr (Kind == ModelKind::FE)
+            for (index_t b = prev.batch_end; b < t.batch_end; ++b) kernel::tet_form_strain(form, b, zeta, g);
+        std::fill(f + 3 * std::size_t(prev.zero_end), f + 3 * std::size_t(t.zero_end), S(0));
+        for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f);
+        if constexpr (Energy)
+            for (index_t e = m.edge_first[prev.vertex_end]; e < m.edge_first[t.vertex_end]; ++e)
+                W += double(zeta[e]) * g[e];
+    });
     return 0.25 * W;
 }
 
@@ -339,9 +387,14 @@ void tet_form_stiffness_all(const EdgeModel<S>& m, const TetEdgeForm<S>& form, c
                             EdgeStiffness<S>& K) {
     const index_t ne = m.num_edges();
     if (K.K.size() != 9 * (std::size_t(ne) + 1)) K.resize(ne);
-    for (index_t e = 0; e < ne; ++e) kernel::edge_stiffness<Definite>(m, e, st.p.data(), st.g.data(), K.K.data());
-    if constexpr (Kind == ModelKind::FE)
-        for (index_t b = 0; b < form.num_batches(); ++b) kernel::tet_form_stiffness(form, b, st.p.data(), K.K.data());
+    const S* p = st.p.data();
+    const double* g = st.g.data();
+    S* Kv = K.K.data();
+    for_form_tiles(form, ne, m.num_vertices, [&](const FormTile& t, const FormTile& prev) {
+        for (index_t e = prev.edge_end; e < t.edge_end; ++e) kernel::edge_stiffness<Definite>(m, e, p, g, Kv);
+        if constexpr (Kind == ModelKind::FE)
+            for (index_t b = prev.batch_end; b < t.batch_end; ++b) kernel::tet_form_stiffness(form, b, p, Kv);
+    });
 }
 
 extern template struct TetEdgeForm<double>;

@@ -378,7 +378,7 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
             return 0;
         }
     each_range(ne, [&](index_t b, index_t e) {
-        for (index_t i = b; i < e; ++i) kernel::edge_strain(m, u, i, p, zeta, g);
+        kernel::edge_strain_range(m, u, b, e, p, zeta, g);
     });
     if constexpr (Kind == ModelKind::FE) {
         switch (variant_) {
@@ -477,7 +477,7 @@ void ParallelEdgeKernels<S>::owner_force_phases(const S* u, S* f, EdgeState<S>& 
         const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
         const index_t eb = es.part_first[q], ee = es.part_first[q + 1];
         if (phase == 0) {
-            for (index_t i = eb; i < ee; ++i) kernel::edge_strain(m, u, i, st.p.data(), st.zeta.data(), st.g.data());
+            kernel::edge_strain_range(m, u, eb, ee, st.p.data(), st.zeta.data(), st.g.data());
             std::fill(f + 3 * std::size_t(vb), f + 3 * std::size_t(ve), S(0));
         } else if (phase == 3) {
             add_incoming_spills<3>(vs, q, f, spill_v_);
