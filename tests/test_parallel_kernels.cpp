@@ -198,8 +198,9 @@ TEST(ParallelEdgeKernels, BlockedColouringsDeterministic) {
 }
 
 // Owner variant with many small parts (the default gives the small test
-// meshes a single part): every part spills, and the results are still
-// bitwise the same for every thread count and close to core.
+// meshes a single part), with the form in tiles of the default size and of
+// 1 and 3 batches: every part spills, and the results are still bitwise the
+// same for every thread count and close to core.
 TEST(ParallelEdgeKernels, OwnerPartsSpillAndStayDeterministic) {
     for (const auto& nm : meshes()) {
         if (nm.mesh.num_vertices() < 40) continue;
@@ -208,10 +209,11 @@ TEST(ParallelEdgeKernels, OwnerPartsSpillAndStayDeterministic) {
         const auto x = deformation_displacement(nm.mesh, Deformation::Random);
         const auto core = run_core<ModelKind::FE>(models.edge, u, x);
         const auto form = make_tet_edge_form<double>(nm.mesh, models.topo, Materials(Material{1e5, 0.3, 1000}));
-        for (index_t parts : {2, 7, 13}) {
+        for (const auto& [parts, tile] : {std::pair<index_t, index_t>{2, 0}, {7, 0}, {13, 0}, {2, 1}, {7, 3}}) {
             PlanOptions opts;
             opts.owner_parts = parts;
-            const std::string tag = nm.name + "/owner-" + std::to_string(parts);
+            opts.form_tile_batches = tile;  // small tiles: many per part (FormTile)
+            const std::string tag = nm.name + "/owner-" + std::to_string(parts) + "-tile-" + std::to_string(tile);
             const ParallelEdgeKernels<double> probe(models.edge, std::make_shared<SerialExecutor>(), Variant::Owner, opts);
             EXPECT_EQ(probe.vertex_parts().parts(), parts) << tag;
             EXPECT_GT(probe.vertex_parts().spill_targets(), 0u) << tag;

@@ -61,7 +61,8 @@ TEST(ParallelTsan, EdgeKernels) {
             std::vector<double> ref_f, ref_y, ref_D, ref_K;
             for (int threads : {1, 3}) {
                 PlanOptions opts;
-                opts.owner_parts = 5;  // the owner variant's spill windows in use (every part spills)
+                opts.owner_parts = 5;        // the owner variant's spill windows in use (every part spills)
+                opts.form_tile_batches = 2;  // and several tiles per part (FormTile)
                 ParallelEdgeKernels<double> k(models.edge, std::make_shared<ThreadExecutor>(threads), v, opts,
                                               tet_local ? form : TetEdgeForm<double>{});
                 std::vector<double> f(u.size()), y(u.size()), D(3 * u.size());

@@ -117,6 +117,7 @@ private:
     void owner_fused_forces(const S* u, S* f, EdgeState<S>& st) const;
     void owner_form_forces(const S* u, S* f, EdgeState<S>& st) const;
     void build_owner_form_parts();
+    void build_owner_form_tiles(index_t batches_per_tile);
     template <class Segment, class Gather, class EdgeTo, class Edge>
     void scatter_to_vertices(S* out, const Segment& segment, const Gather& gather, const EdgeTo& edge_to,
                              const Edge& edge) const;
@@ -167,6 +168,14 @@ private:
     // update).
     std::vector<index_t> form_spill_first_;
     ForwardSpill fspill_;
+    // Owner variant with the form, per part: the end of its head (its edges
+    // that earlier parts' batches read, strained before the others and
+    // final only once the windows are in), the end of the vertices whose
+    // segments hold head edges (scattered last), and its tiles
+    // (owner_tiles_[tile_first_[q] .. tile_first_[q + 1]), FormTile).
+    std::vector<index_t> head_end_, defer_end_, tile_first_;
+    std::vector<FormTile> owner_tiles_;
+    index_t form_tile_batches_ = kFormTileBatches;
     mutable std::vector<double> spill_fg_;
     mutable std::vector<S> spill_fk_;  // owner stiffness from the form: K windows
     // Private accumulators (allocated on first use).
@@ -192,7 +201,8 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
       range_chunk_(std::max<index_t>(1, opts.range_chunk)),
       parts_(std::max(1, ex_->threads())),
       form_(std::move(form)),
-      form_forces_(opts.form_forces) {
+      form_forces_(opts.form_forces),
+      form_tile_batches_(opts.form_tile_batches > 0 ? opts.form_tile_batches : kFormTileBatches) {
     const index_t ne = m_.num_edges(), nv = m_.num_vertices;
     const index_t owner_parts = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv);
     if (variant_ == Variant::Auto) {
@@ -458,6 +468,58 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
     fspill_ = make_forward_spill(ne, espill_.part_first, [&reach](index_t e) { return reach[e]; });
     if (form_forces()) spill_fg_.assign(fspill_.spill_targets(), 0.0);
     spill_fk_.assign(9 * fspill_.spill_targets(), S(0));
+    build_owner_form_tiles(form_tile_batches_);
+}
+
+// Each part's head (its edges that earlier parts' batches read and write
+// through their windows), the vertices whose segments hold head edges, and
+// the part's tiles: FormTile ends within the part's batches, edges and
+// vertices, as plan_form_tiles plans them for the whole mesh.
+template <class S>
+void ParallelEdgeKernels<S>::build_owner_form_tiles(index_t batches_per_tile) {
+    const auto& m = m_;
+    const auto& f = form_;
+    constexpr int L = kTetLanes<S>;
+    const ForwardSpill &vs = vspill_, &fs = fspill_;
+    const index_t P = vs.parts();
+    head_end_.assign(std::size_t(P), 0);
+    defer_end_.assign(std::size_t(P), 0);
+    tile_first_.assign(std::size_t(P) + 1, 0);
+    owner_tiles_.clear();
+    index_t reach = 0;  // one past the last edge the earlier parts' batches touch
+    for (index_t q = 0; q < P; ++q) {
+        const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
+        const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
+        const index_t head = std::clamp(reach, eb, ee);
+        head_end_[q] = head;
+        defer_end_[q] = head > eb ? m.edge[head - 1][0] + 1 : vb;
+        const index_t bb = form_batch_first_[q], be = form_batch_first_[q + 1];
+        std::vector<index_t> low(std::size_t(be - bb)), high(std::size_t(be - bb));
+        for (index_t b = bb; b < be; ++b) {
+            index_t lo = ve, hi = 0;
+            for (int k = 0; k < 6; ++k)
+                for (int l = 0; l < f.batch_size(b); ++l) {
+                    const index_t e = f.edge[(std::size_t(b) * 6 + k) * L + l];
+                    lo = std::min(lo, m.edge[e][0]);
+                    hi = std::max(hi, e + 1);
+                }
+            low[b - bb] = lo;
+            high[b - bb] = hi;
+            reach = std::max(reach, hi);
+        }
+        std::vector<index_t> low_after(low.size() + 1, ve);
+        for (std::size_t i = low.size(); i-- > 0;) low_after[i] = std::min(low_after[i + 1], low[i]);
+        index_t edge_end = head, vertex_end = defer_end_[q];
+        for (index_t b0 = bb; b0 < be || b0 == bb; b0 += batches_per_tile) {
+            const index_t b1 = std::min(be, b0 + batches_per_tile);
+            for (index_t b = b0; b < b1; ++b) edge_end = std::max(edge_end, std::min(high[b - bb], ee));
+            vertex_end = std::max(vertex_end, b1 == be ? ve : std::min(low_after[b1 - bb], ve));
+            edge_end = std::max(edge_end, m.edge_first[vertex_end]);
+            owner_tiles_.push_back({b1, b1 == be ? ee : edge_end, vertex_end, vertex_end});
+            if (b1 == be) break;
+        }
+        tile_first_[q + 1] = index_t(owner_tiles_.size());
+    }
 }
 
 // The owner variant's FE forces in one region of 4 phases over the parts
@@ -522,20 +584,39 @@ void ParallelEdgeKernels<S>::owner_fused_forces(const S* u, S* f, EdgeState<S>& 
 template <class S>
 void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& st) const {
     const auto& m = m_;
-    const ForwardSpill& fs = fspill_;
-    const S* p = st.p.data();
-    const S* zeta = st.zeta.data();
+    const ForwardSpill &vs = vspill_, &fs = fspill_;
+    S* p = st.p.data();
+    S* zeta = st.zeta.data();
     double* g = st.g.data();
-    owner_force_phases(u, f, st, [&](int phase, index_t q, index_t vb, index_t ve, index_t ee,
-                                     const kernel::ForwardOut<S>& fout) {
-        if (phase == 1) {
+    const index_t P = vs.parts();
+    const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
+    ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
+        const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
+        const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
+        const kernel::ForwardOut<S> fout{f, spill_v_.data() + 3 * vs.window_first[q], ve};
+        if (phase == 0) {
+            kernel::edge_strain_range(m, u, eb, head_end_[q], p, zeta, g);
+            std::fill(f + 3 * std::size_t(vb), f + 3 * std::size_t(ve), S(0));
+        } else if (phase == 1) {
+            // Tile by tile: the rest of the part's strains, its batches,
+            // and the scatter of the segments whose g is final.
             const kernel::ForwardOut<double> gout{g, spill_fg_.data() + fs.window_first[q], ee};
-            for (index_t b = form_batch_first_[q]; b < form_spill_first_[q]; ++b) kernel::tet_form_strain(form_, b, zeta, g);
-            for (index_t b = form_spill_first_[q]; b < form_batch_first_[q + 1]; ++b)
-                kernel::tet_form_strain(form_, b, zeta, gout);
-        } else {
+            FormTile prev{form_batch_first_[q], head_end_[q], defer_end_[q], 0};
+            for (index_t i = tile_first_[q]; i < tile_first_[q + 1]; ++i) {
+                const FormTile& t = owner_tiles_[i];
+                kernel::edge_strain_range(m, u, prev.edge_end, t.edge_end, p, zeta, g);
+                const index_t split = std::clamp(form_spill_first_[q], prev.batch_end, t.batch_end);
+                for (index_t b = prev.batch_end; b < split; ++b) kernel::tet_form_strain(form_, b, zeta, g);
+                for (index_t b = split; b < t.batch_end; ++b) kernel::tet_form_strain(form_, b, zeta, gout);
+                for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
+                prev = t;
+            }
+        } else if (phase == 2) {
+            // The head: its incoming windows added, then its segments.
             add_incoming_spills<1>(fs, q, g, spill_fg_);
-            for (index_t a = vb; a < ve; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
+            for (index_t a = vb; a < defer_end_[q]; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
+        } else {
+            add_incoming_spills<3>(vs, q, f, spill_v_);
         }
     });
 }
@@ -572,13 +653,18 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
         const index_t phase_first[3] = {0, P, 2 * P};
         ex_->for_phases(2, phase_first, [&](int phase, index_t q) {
             const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
-            if (phase == 0) {
-                for (index_t i = eb; i < ee; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
+            if (phase == 0) {  // tile by tile (FormTile): the edge terms, then the batches
                 const kernel::ForwardOut<S> kout{K, spill_fk_.data() + 9 * fs.window_first[q], ee};
-                for (index_t b = form_batch_first_[q]; b < form_spill_first_[q]; ++b)
-                    kernel::tet_form_stiffness(form_, b, p, K);
-                for (index_t b = form_spill_first_[q]; b < form_batch_first_[q + 1]; ++b)
-                    kernel::tet_form_stiffness(form_, b, p, kout);
+                index_t e0 = eb, b0 = form_batch_first_[q];
+                for (index_t t = tile_first_[q]; t < tile_first_[q + 1]; ++t) {
+                    const index_t e1 = std::max(e0, owner_tiles_[t].edge_end), b1 = owner_tiles_[t].batch_end;
+                    for (index_t i = e0; i < e1; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
+                    const index_t split = std::clamp(form_spill_first_[q], b0, b1);
+                    for (index_t b = b0; b < split; ++b) kernel::tet_form_stiffness(form_, b, p, K);
+                    for (index_t b = split; b < b1; ++b) kernel::tet_form_stiffness(form_, b, p, kout);
+                    e0 = e1;
+                    b0 = b1;
+                }
             } else {
                 add_incoming_spills<9>(fs, q, K, spill_fk_);
             }

@@ -105,6 +105,9 @@ struct PlanOptions {
     // scatter, consecutive edges for the TSEP loop, each balanced on the
     // loop's work). 0: default_owner_parts(#V).
     index_t owner_parts = 0;
+    // Owner variant with the form: batches per tile of a part's sweep
+    // (FormTile). 0: kFormTileBatches.
+    index_t form_tile_batches = 0;
     bool stiffness = true;               // build what the stiffness kernels need
 };
 
