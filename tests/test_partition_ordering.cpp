@@ -104,3 +104,39 @@ TEST(Ordering, OrderedSimulatorIsInvisibleToTheUser) {
         EXPECT_NEAR(x[3 * (s.mesh.num_vertices() - 1)], s.mesh.X[3 * (s.mesh.num_vertices() - 1)] + ref[3 * (s.mesh.num_vertices() - 1)], 1e-12);
     }
 }
+
+// An explicit step far past the stability limit: the error an
+// OrderedSimulator throws names the vertex in the user's numbering (vertex()
+// and the message), the one the simulator on the renumbered scene names.
+TEST(Ordering, OrderedSimulatorErrorsNameUserVertices) {
+    Scene s = edgefem::test::clamped_box_scene(6, 3, 3, 1e9);
+    s.integrator = Integrator::Explicit;
+    s.dt = 0.01;
+    for (Ordering o : {Ordering::Input, Ordering::Random, Ordering::RCM}) {
+        SCOPED_TRACE(to_string(o));
+        const std::vector<index_t> new_of_old = vertex_ordering(s.mesh, o);
+        Simulator<double> internal(permute_scene(s, new_of_old));
+        index_t internal_vertex = -1;
+        try {
+            for (int k = 0; k < 200; ++k) internal.step();
+        } catch (const SimulationError& e) {
+            internal_vertex = e.vertex();
+        }
+        ASSERT_GE(internal_vertex, 0) << "the scene should blow up and name a vertex";
+        OrderedSimulator<double> ordered(s, o);
+        bool thrown = false;
+        try {
+            for (int k = 0; k < 200; ++k) ordered.step();
+        } catch (const SimulationError& e) {
+            thrown = true;
+            ASSERT_GE(e.vertex(), 0);
+            EXPECT_EQ(new_of_old[e.vertex()], internal_vertex);
+            const std::string msg = e.what(), name = "vertex " + std::to_string(e.vertex());
+            const std::size_t at = msg.find(name);
+            ASSERT_NE(at, std::string::npos) << msg;
+            EXPECT_FALSE(at + name.size() < msg.size() && std::isdigit(static_cast<unsigned char>(msg[at + name.size()])))
+                << msg;
+        }
+        EXPECT_TRUE(thrown);
+    }
+}

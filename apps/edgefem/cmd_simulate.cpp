@@ -13,6 +13,7 @@
 #include "common.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/write_vtu.hpp"
+#include "edgefem/partition/ordered_simulator.hpp"
 #include "sim_common.hpp"
 
 namespace edgefem::cli {
@@ -23,6 +24,10 @@ struct SimulateOptions {
     std::string scene;  // empty: the built-in default
     std::string out;    // overrides output.dir
     int steps = -1;     // >= 0 overrides the scene's steps
+    // The internal vertex numbering: RCM by default (the force on bunny-1m
+    // runs 2.4x faster than in TetGen's numbering, docs/layouts.md); frames
+    // and messages stay in the mesh's numbering.
+    std::string ordering = "rcm";
     ExecOptions exec;
 };
 
@@ -78,8 +83,10 @@ void run_simulate(const SimulateOptions& opts) {
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
     const auto executor = opts.exec.executor();
-    Simulator<double> sim(std::move(sf.scene), executor, operator_factory<double>(opts.exec, executor));
-    const Scene& scene = sim.scene();
+    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.ordering), executor,
+                                  operator_factory<double>(opts.exec, executor));
+    Simulator<double>& sim = osim.internal();
+    const Scene& scene = sf.scene;  // the user's numbering
     const long steps = scene.steps;
 
     std::optional<FrameWriter> frames;
@@ -90,11 +97,14 @@ void run_simulate(const SimulateOptions& opts) {
         series.emplace((std::filesystem::path(out.dir) / (name + ".pvd")).string());
     }
     char frame_name[64];
+    std::vector<double> u_user(3 * std::size_t(scene.mesh.num_vertices())), f_user(u_user.size());
     const auto write_frame = [&] {
         if (!frames) return;
         std::snprintf(frame_name, sizeof frame_name, "_%06ld.vtu", sim.step_index());
         const std::string path = (std::filesystem::path(out.dir) / (name + frame_name)).string();
-        frames->write(path, sim.displacement(), sim.forces());
+        osim.get_displacement(u_user);
+        osim.get_forces(f_user);
+        frames->write(path, u_user, f_user);
         series->add(sim.time(), path);
         series->write();  // a crash later still leaves a usable series
     };
@@ -120,7 +130,7 @@ void run_simulate(const SimulateOptions& opts) {
     try {
         for (long s = 1; s <= steps; ++s) {
             const auto t0 = clock::now();
-            const StepStats& st = sim.step();
+            const StepStats& st = osim.step();
             step_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
             force_ms.push_back(st.force_ms);
             stiffness_ms.push_back(st.stiffness_ms);
@@ -145,6 +155,7 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("vertices", scene.mesh.num_vertices());
     print_kv("tets", scene.mesh.num_tets());
     print_kv("integrator", to_string(scene.integrator));
+    print_kv("ordering", opts.ordering);
     print_kv("steps", steps);
     print_kv("ms_per_step", fmt(median(step_ms), 6));
     print_kv("force_ms", fmt(median(force_ms), 6));
@@ -176,6 +187,7 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--steps", opts->steps, "Number of steps (overrides the scene's steps)")
         ->check(CLI::NonNegativeNumber);
     cmd->footer(kExitCodesHelp);
+    add_ordering_option(*cmd, opts->ordering);
     add_exec_options(*cmd, opts->exec);
     cmd->callback([opts] { run_simulate(*opts); });
 }

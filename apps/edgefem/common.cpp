@@ -31,9 +31,15 @@ void add_mesh_options(CLI::App& cmd, MeshOptions& opts) {
     cmd.add_flag("--fix-orientation", opts.fix_orientation,
                  "Reorient negatively oriented tets instead of rejecting the mesh");
     cmd.add_flag("--compact", opts.compact, "Remove vertices that no tet uses");
-    cmd.add_option("--ordering", opts.ordering,
-                   "Renumber vertices for memory locality (input/output stay in the mesh's numbering)")
-        ->check(CLI::IsMember({"input", "random", "rcm", "morton", "nd", "metis"}));
+    add_ordering_option(cmd, opts.ordering);
+}
+
+void add_ordering_option(CLI::App& cmd, std::string& ordering) {
+    cmd.add_option("--ordering", ordering,
+                   "Renumber vertices for memory locality: input, random, rcm, morton, nd or metis "
+                   "(docs/layouts.md; input and output stay in the mesh's numbering)")
+        ->check(CLI::IsMember({"input", "random", "rcm", "morton", "nd", "metis"}))
+        ->capture_default_str();
 }
 
 LoadedMesh load_mesh(const MeshOptions& opts) {

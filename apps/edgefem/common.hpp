@@ -30,6 +30,9 @@ struct MeshOptions {
     std::string ordering = "input";  // input | random | rcm | morton | nd | metis
 };
 
+// --ordering NAME into `ordering` (its value on entry is the default).
+void add_ordering_option(CLI::App& cmd, std::string& ordering);
+
 struct LoadedMesh {
     // `mesh` is what the kernels run on: renumbered by --ordering when one is
     // given (new_of_old non-empty); `user` then keeps the mesh as read, and

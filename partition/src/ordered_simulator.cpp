@@ -1,5 +1,9 @@
 #include "edgefem/partition/ordered_simulator.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <string>
+
 #include "edgefem/partition/permute_mesh.hpp"
 
 namespace edgefem {
@@ -31,6 +35,45 @@ OrderedSimulator<S>::OrderedSimulator(const Scene& scene, Ordering ordering, std
                                       OperatorFactory<S> factory, const OrderingOptions& options)
     : new_of_old_((scene.validate(), vertex_ordering(scene.mesh, ordering, options))),
       sim_(permute_scene(scene, new_of_old_), std::move(executor), std::move(factory)) {}
+
+namespace {
+// The error with its vertex (and the message's "vertex N") in the user's
+// numbering.
+SimulationError to_user_numbering(const SimulationError& e, const std::vector<index_t>& new_of_old) {
+    if (e.vertex() < 0) return e;
+    const auto it = std::find(new_of_old.begin(), new_of_old.end(), e.vertex());
+    if (it == new_of_old.end()) return e;
+    const index_t user = index_t(it - new_of_old.begin());
+    std::string message = e.what();
+    const std::string internal_name = "vertex " + std::to_string(e.vertex());
+    for (std::size_t at = message.find(internal_name); at != std::string::npos;
+         at = message.find(internal_name, at + 1)) {
+        const std::size_t end = at + internal_name.size();
+        if (end < message.size() && std::isdigit(static_cast<unsigned char>(message[end]))) continue;  // a longer number
+        message.replace(at, internal_name.size(), "vertex " + std::to_string(user));
+        break;
+    }
+    return SimulationError(message, e.step(), user);
+}
+}  // namespace
+
+template <class S>
+const StepStats& OrderedSimulator<S>::step() {
+    try {
+        return sim_.step();
+    } catch (const SimulationError& e) {
+        throw to_user_numbering(e, new_of_old_);
+    }
+}
+
+template <class S>
+StaticResult OrderedSimulator<S>::solve_static() {
+    try {
+        return sim_.solve_static();
+    } catch (const SimulationError& e) {
+        throw to_user_numbering(e, new_of_old_);
+    }
+}
 
 template <class S>
 void OrderedSimulator<S>::get_displacement(std::span<double> out) const {

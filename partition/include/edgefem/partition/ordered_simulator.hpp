@@ -1,8 +1,9 @@
 // A Simulator that runs on a renumbered copy of the scene (for memory
 // locality) while the application keeps its own vertex numbering: every
 // vertex array in and out is in the user's numbering (copied through the
-// permutation). The core Simulator's zero-copy views are available through
-// internal(), in the internal numbering.
+// permutation), and so are the vertices that errors name. The core
+// Simulator's zero-copy views are available through internal(), in the
+// internal numbering.
 #pragma once
 
 #include <span>
@@ -23,8 +24,10 @@ public:
     OrderedSimulator(const Scene& scene, Ordering ordering, std::shared_ptr<const Executor> executor = nullptr,
                      OperatorFactory<S> factory = {}, const OrderingOptions& options = {});
 
-    const StepStats& step() { return sim_.step(); }
-    StaticResult solve_static() { return sim_.solve_static(); }
+    // A SimulationError names its vertex in the user's numbering (vertex()
+    // and the message's "vertex N").
+    const StepStats& step();
+    StaticResult solve_static();
     Energies energies() { return sim_.energies(); }
     double time() const { return sim_.time(); }
 
