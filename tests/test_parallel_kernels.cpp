@@ -389,3 +389,20 @@ TEST(ParallelTetKernels, MatchSerial) {
         }
     }
 }
+
+// The owner variant's default part count (variant.hpp): the mesh's power of
+// two near cbrt(#V) / 2.5 in 4..64, capped by the machine's power of two at
+// or above its hardware threads (at least 4).
+TEST(ParallelEdgeKernels, DefaultOwnerPartsFollowMeshAndMachine) {
+    // cbrt(180000) / 2.5 = 22.6 -> 16 (log scale); cbrt(4000) / 2.5 = 6.3 -> 8; cbrt(100) / 2.5 = 1.9 -> 4 (floor).
+    EXPECT_EQ(default_owner_parts(180000, 64), 16);
+    EXPECT_EQ(default_owner_parts(180000, 16), 16);
+    EXPECT_EQ(default_owner_parts(180000, 9), 16);
+    EXPECT_EQ(default_owner_parts(180000, 8), 8);
+    EXPECT_EQ(default_owner_parts(180000, 2), 4);
+    EXPECT_EQ(default_owner_parts(180000, 1), 4);
+    EXPECT_EQ(default_owner_parts(4000, 64), 8);
+    EXPECT_EQ(default_owner_parts(100, 64), 4);
+    EXPECT_EQ(default_owner_parts(100, 1), 4);
+    EXPECT_EQ(default_owner_parts(100000000, 1000), 64);
+}

@@ -30,6 +30,7 @@
 #include "edgefem/core/executor.hpp"
 #include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/parallel/colouring.hpp"
+#include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/forward_spill.hpp"
 #include "edgefem/parallel/loops.hpp"
 #include "edgefem/parallel/variant.hpp"
@@ -204,7 +205,7 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
       form_forces_(opts.form_forces),
       form_tile_batches_(opts.form_tile_batches > 0 ? opts.form_tile_batches : kFormTileBatches) {
     const index_t ne = m_.num_edges(), nv = m_.num_vertices;
-    const index_t owner_parts = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv);
+    const index_t owner_parts = opts.owner_parts > 0 ? opts.owner_parts : default_owner_parts(nv, hardware_threads());
     if (variant_ == Variant::Auto) {
         // Owner wins every kernel at 1 and 2 threads when the numbering has
         // locality (docs/parallel.md); without it (TetGen's input order on
