@@ -13,6 +13,7 @@
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
+#include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/stream_bandwidth.hpp"
@@ -165,4 +166,19 @@ TEST(StreamBandwidth, TrafficModelsCountTheArrays) {
     // float halves the coefficients and state but not the indices or g.
     EXPECT_LT(force_bytes_per_call(mf), force_bytes_per_call(md));
     EXPECT_GT(force_bytes_per_call(mf), 0.5 * force_bytes_per_call(md));
+
+    // The force from the tet-local form: the TSEP arrays replaced by the
+    // form's, zeta read again by the form pass; in tiles, the state counted
+    // once (as written), its read-backs cached.
+    TetEdgeForm<double> form = make_tet_edge_form<double>(mesh, topo, Materials(Material{1e5, 0.3, 1000}));
+    const double E = md.num_edges();
+    const double sn = force_bytes_per_call(md, ModelKind::SN);
+    const double arrays = size_bytes(form.edge) + size_bytes(form.A);
+    form.tiles.clear();
+    EXPECT_DOUBLE_EQ(form_force_bytes_per_call(md, form), sn + arrays + 8 * E);
+    form.tiles = plan_form_tiles(form, topo.edges, topo.first_edge, 1);
+    ASSERT_GT(form.tiles.size(), 1u);
+    EXPECT_DOUBLE_EQ(form_force_bytes_per_call(md, form), sn + arrays - 3 * 8 * E - 8 * E);
+    EXPECT_DOUBLE_EQ(form_force_bytes_per_call(md, form, TrafficModel::PerPass),
+                     force_bytes_per_call(md, ModelKind::SN, TrafficModel::PerPass) + arrays + 8 * E + 2 * 8 * E);
 }

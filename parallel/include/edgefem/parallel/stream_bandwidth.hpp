@@ -137,13 +137,23 @@ double force_bytes_per_call(const EdgeModel<S>& m, ModelKind kind = ModelKind::F
 // included); zeta is read again by the form pass. PerPass adds the edge
 // re-read by the scatter, the form pass's read-modify-write of g
 // (+2 #E double) and f's zero fill and scatter (+2 x 3 #V S).
+// When the form runs in tiles (FormTile: more than one), the passes read
+// the state back while a tile's p~, zeta and g are cached: Compulsory then
+// counts the state once, as written (p~ 3 #E S, zeta #E S, g #E double),
+// and the reads not at all. (The owner variant re-reads each part's head
+// after its barrier, which this leaves out: it counts too few bytes there,
+// never too many.)
 template <class S>
 double form_force_bytes_per_call(const EdgeModel<S>& m, const TetEdgeForm<S>& form,
                                  TrafficModel model = TrafficModel::Compulsory) {
     const auto bytes_of = [](const auto& v) { return detail::traffic_bytes_of(v); };
     const double E = m.num_edges(), s = sizeof(S);
     double b = force_bytes_per_call(m, ModelKind::SN, model);  // strains, scatter, p~ / zeta / g, u, f
-    b += bytes_of(form.edge) + bytes_of(form.A) + E * s;       // + zeta read by the form pass
+    b += bytes_of(form.edge) + bytes_of(form.A);
+    if (model == TrafficModel::Compulsory && form.tiles.size() > 1)
+        b -= 3 * E * s + E * sizeof(double);  // p~ and g read back from the cache
+    else
+        b += E * s;  // zeta read by the form pass
     if (model == TrafficModel::PerPass) b += 2 * E * sizeof(double);
     return b;
 }
