@@ -151,4 +151,9 @@ TEST(TetEdgeForm, TilePlanRejectsNonsense) {
     EXPECT_THROW(plan_form_tiles(form, m.topo.edges, m.topo.first_edge, 0), InvalidArgument);
     std::vector<index_t> short_first(m.topo.first_edge.begin(), m.topo.first_edge.end() - 1);
     EXPECT_THROW(plan_form_tiles(form, m.topo.edges, short_first, 16), InvalidArgument);
+    const index_t nb = form.num_batches(), ne = m.topo.num_edges(), nv = mesh.num_vertices();
+    for (const FormTileRange& bad : {FormTileRange{0, nb + 1, 0, ne, 0, nv}, FormTileRange{2, 1, 0, ne, 0, nv},
+                                     FormTileRange{0, nb, 0, ne + 1, 0, nv}, FormTileRange{0, nb, 0, ne, 0, nv + 1},
+                                     FormTileRange{0, nb, 0, ne, -1, nv}})
+        EXPECT_THROW(plan_form_tiles(form, m.topo.edges, m.topo.first_edge, 16, bad), InvalidArgument);
 }

@@ -92,7 +92,6 @@ std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vec
     if (batches_per_tile < 1) throw InvalidArgument("plan_form_tiles: batches_per_tile must be >= 1");
     if (first_edge.empty() || first_edge.front() != 0 || first_edge.back() != index_t(edges.size()))
         throw InvalidArgument("plan_form_tiles: first_edge does not match the edge list");
-    constexpr int L = kTetLanes<S>;
     const index_t nb = form.num_batches(), nv = index_t(first_edge.size()) - 1, ne = index_t(edges.size());
     for (index_t v = 0; v < nv; ++v) {
         if (first_edge[v + 1] < first_edge[v])
@@ -102,11 +101,27 @@ std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vec
                 throw InvalidArgument("plan_form_tiles: edge " + std::to_string(e) +
                                       " is not listed under its V0 or its V1 is out of range");
     }
+    return plan_form_tiles(form, edges, first_edge, batches_per_tile, FormTileRange{0, nb, 0, ne, 0, nv});
+}
+
+template <class S>
+std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vector<std::array<index_t, 2>>& edges,
+                                      const std::vector<index_t>& first_edge, index_t batches_per_tile,
+                                      const FormTileRange& r) {
+    if (batches_per_tile < 1) throw InvalidArgument("plan_form_tiles: batches_per_tile must be >= 1");
+    const index_t nv = index_t(first_edge.size()) - 1, ne = index_t(edges.size());
+    if (!(0 <= r.batch_begin && r.batch_begin <= r.batch_end && r.batch_end <= form.num_batches() &&
+          0 <= r.edge_begin && r.edge_begin <= r.edge_end && r.edge_end <= ne && 0 <= r.vertex_begin &&
+          r.vertex_begin <= r.vertex_end && r.vertex_end <= nv))
+        throw InvalidArgument("plan_form_tiles: the range lies outside the form, the edges or the vertices");
+    constexpr int L = kTetLanes<S>;
+    const index_t nb = r.batch_end - r.batch_begin;
     // Per batch: the lowest V0 of its edges (its tets' lowest vertex) and
     // its largest edge id; real lanes only (padding lanes are never written).
     std::vector<index_t> low(nb), high(nb);
-    for (index_t b = 0; b < nb; ++b) {
-        index_t lo = nv, hi = 0;
+    for (index_t i = 0; i < nb; ++i) {
+        const index_t b = r.batch_begin + i;
+        index_t lo = r.vertex_end, hi = 0;
         for (int k = 0; k < 6; ++k)
             for (int l = 0; l < form.batch_size(b); ++l) {
                 const index_t e = form.edge[(std::size_t(b) * 6 + k) * L + l];
@@ -114,24 +129,26 @@ std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vec
                 lo = std::min(lo, edges[e][0]);
                 hi = std::max(hi, e + 1);
             }
-        low[b] = lo;
-        high[b] = hi;
+        low[i] = lo;
+        high[i] = hi;
     }
-    std::vector<index_t> low_after(std::size_t(nb) + 1, nv);  // lowest V0 of the batches from b on
-    for (index_t b = nb; b-- > 0;) low_after[b] = std::min(low_after[b + 1], low[b]);
+    std::vector<index_t> low_after(std::size_t(nb) + 1, r.vertex_end);  // lowest V0 of the batches from i on
+    for (index_t i = nb; i-- > 0;) low_after[i] = std::min(low_after[i + 1], low[i]);
     std::vector<FormTile> tiles;
-    index_t edge_end = 0, zero_end = 0, vertex_end = 0, scanned = 0;
-    for (index_t b0 = 0; b0 < nb || tiles.empty(); b0 += batches_per_tile) {
-        const index_t b1 = std::min(nb, b0 + batches_per_tile);
-        for (index_t b = b0; b < b1; ++b) edge_end = std::max(edge_end, high[b]);
+    index_t edge_end = r.edge_begin, zero_end = r.vertex_begin, vertex_end = r.vertex_begin;
+    index_t scanned = first_edge[r.vertex_begin];
+    for (index_t i0 = 0;; i0 += batches_per_tile) {
+        const index_t i1 = std::min(nb, i0 + batches_per_tile);
+        const bool last = i1 == nb;
+        for (index_t i = i0; i < i1; ++i) edge_end = std::max(edge_end, std::min(high[i], r.edge_end));
         // Segments below the next tiles' lowest vertex have all their batches.
-        vertex_end = std::max(vertex_end, b1 == nb ? nv : low_after[b1]);
+        vertex_end = std::max(vertex_end, last ? r.vertex_end : std::min(low_after[i1], r.vertex_end));
         edge_end = std::max(edge_end, first_edge[vertex_end]);  // the scatter reads their p~
         // The scatter writes f(V1) of those segments' edges: zeroed first.
         for (; scanned < first_edge[vertex_end]; ++scanned) zero_end = std::max(zero_end, edges[scanned][1] + 1);
         zero_end = std::max(zero_end, vertex_end);
-        tiles.push_back({b1, b1 == nb ? ne : edge_end, vertex_end, b1 == nb ? nv : zero_end});
-        if (b1 == nb) break;
+        tiles.push_back({r.batch_begin + i1, last ? r.edge_end : edge_end, vertex_end, last ? r.vertex_end : zero_end});
+        if (last) break;
     }
     return tiles;
 }
@@ -146,5 +163,11 @@ template std::vector<FormTile> plan_form_tiles<double>(const TetEdgeForm<double>
 template std::vector<FormTile> plan_form_tiles<float>(const TetEdgeForm<float>&,
                                                       const std::vector<std::array<index_t, 2>>&,
                                                       const std::vector<index_t>&, index_t);
+template std::vector<FormTile> plan_form_tiles<double>(const TetEdgeForm<double>&,
+                                                       const std::vector<std::array<index_t, 2>>&,
+                                                       const std::vector<index_t>&, index_t, const FormTileRange&);
+template std::vector<FormTile> plan_form_tiles<float>(const TetEdgeForm<float>&,
+                                                      const std::vector<std::array<index_t, 2>>&,
+                                                      const std::vector<index_t>&, index_t, const FormTileRange&);
 
 }  // namespace edgefem

@@ -119,6 +119,22 @@ template <class S>
 std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vector<std::array<index_t, 2>>& edges,
                                       const std::vector<index_t>& first_edge, index_t batches_per_tile);
 
+// A stretch of the sweep (the owner variant's parts, parallel/): batches
+// [batch_begin, batch_end); the edge loop starts at edge_begin and stops at
+// edge_end (later edges are another part's), the scatter starts at vertex
+// vertex_begin and stops at vertex_end. The last tile ends at batch_end,
+// edge_end and vertex_end.
+struct FormTileRange {
+    index_t batch_begin, batch_end, edge_begin, edge_end, vertex_begin, vertex_end;
+};
+// The tiles of one stretch (the overload above: the whole mesh, after
+// checking the edge list). Throws InvalidArgument for a range outside the
+// form, the edges or the vertices.
+template <class S>
+std::vector<FormTile> plan_form_tiles(const TetEdgeForm<S>& form, const std::vector<std::array<index_t, 2>>& edges,
+                                      const std::vector<index_t>& first_edge, index_t batches_per_tile,
+                                      const FormTileRange& range);
+
 namespace kernel {
 
 // kTetLanes<S> values of S, one per tet of a batch: a GCC/Clang vector for

@@ -473,53 +473,31 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
 }
 
 // Each part's head (its edges that earlier parts' batches read and write
-// through their windows), the vertices whose segments hold head edges, and
-// the part's tiles: FormTile ends within the part's batches, edges and
-// vertices, as plan_form_tiles plans them for the whole mesh.
+// through their windows: up to the furthest window end before it), the
+// vertices whose segments hold head edges, and the part's tiles
+// (plan_form_tiles over the part's batches, from the end of its head;
+// the part zeroes its f in phase 0, so the tiles' zero_end goes unused).
 template <class S>
 void ParallelEdgeKernels<S>::build_owner_form_tiles(index_t batches_per_tile) {
-    const auto& m = m_;
-    const auto& f = form_;
-    constexpr int L = kTetLanes<S>;
     const ForwardSpill &vs = vspill_, &fs = fspill_;
     const index_t P = vs.parts();
     head_end_.assign(std::size_t(P), 0);
     defer_end_.assign(std::size_t(P), 0);
     tile_first_.assign(std::size_t(P) + 1, 0);
     owner_tiles_.clear();
-    index_t reach = 0;  // one past the last edge the earlier parts' batches touch
+    index_t reach = 0;  // the furthest window end of the earlier parts
     for (index_t q = 0; q < P; ++q) {
         const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
         const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
         const index_t head = std::clamp(reach, eb, ee);
         head_end_[q] = head;
-        defer_end_[q] = head > eb ? m.edge[head - 1][0] + 1 : vb;
-        const index_t bb = form_batch_first_[q], be = form_batch_first_[q + 1];
-        std::vector<index_t> low(std::size_t(be - bb)), high(std::size_t(be - bb));
-        for (index_t b = bb; b < be; ++b) {
-            index_t lo = ve, hi = 0;
-            for (int k = 0; k < 6; ++k)
-                for (int l = 0; l < f.batch_size(b); ++l) {
-                    const index_t e = f.edge[(std::size_t(b) * 6 + k) * L + l];
-                    lo = std::min(lo, m.edge[e][0]);
-                    hi = std::max(hi, e + 1);
-                }
-            low[b - bb] = lo;
-            high[b - bb] = hi;
-            reach = std::max(reach, hi);
-        }
-        std::vector<index_t> low_after(low.size() + 1, ve);
-        for (std::size_t i = low.size(); i-- > 0;) low_after[i] = std::min(low_after[i + 1], low[i]);
-        index_t edge_end = head, vertex_end = defer_end_[q];
-        for (index_t b0 = bb; b0 < be || b0 == bb; b0 += batches_per_tile) {
-            const index_t b1 = std::min(be, b0 + batches_per_tile);
-            for (index_t b = b0; b < b1; ++b) edge_end = std::max(edge_end, std::min(high[b - bb], ee));
-            vertex_end = std::max(vertex_end, b1 == be ? ve : std::min(low_after[b1 - bb], ve));
-            edge_end = std::max(edge_end, m.edge_first[vertex_end]);
-            owner_tiles_.push_back({b1, b1 == be ? ee : edge_end, vertex_end, vertex_end});
-            if (b1 == be) break;
-        }
+        defer_end_[q] = head > eb ? m_.edge[head - 1][0] + 1 : vb;
+        const auto tiles = plan_form_tiles(form_, m_.edge, m_.edge_first, batches_per_tile,
+                                           FormTileRange{form_batch_first_[q], form_batch_first_[q + 1], head, ee,
+                                                         defer_end_[q], ve});
+        owner_tiles_.insert(owner_tiles_.end(), tiles.begin(), tiles.end());
         tile_first_[q + 1] = index_t(owner_tiles_.size());
+        reach = std::max(reach, fs.window_end[q]);
     }
 }
 
