@@ -35,6 +35,7 @@ struct BenchOptions {
     double seconds = 1.0;
     int cg_iters = 0;  // step: > 0 runs exactly this many CG iterations
     bool stream = false;  // also measure the STREAM bandwidth on the same executor
+    int stream_rounds = 5;  // with stream: kernel and triad alternate this many times
 };
 
 const std::map<std::string, Kernel> kKernels = {{"force", Kernel::Force},
@@ -137,16 +138,39 @@ void run_bench(const BenchOptions& opts) {
     // kx multiplies a generic (non-smooth) vector.
     eval->prepare(kernel, deformation_displacement(mesh, Deformation::Random));
 
-    const std::vector<double> ns = time_calls(opts.seconds, [&] {
+    const auto call = [&] {
         eval->run(kernel);
         eval->consume();
-    });
+    };
+    // With --stream, the timed calls and STREAM alternate in rounds on the
+    // kernels' executor (same back-end and threads, the kernel's data still
+    // allocated): on a shared machine the bandwidth on offer drifts within
+    // seconds, so each round's calls are set against the triad measured
+    // right after them, and the median of those paired fractions is
+    // reported next to the fraction of the overall medians.
+    const int rounds = opts.stream ? opts.stream_rounds : 1;
+    std::vector<double> ns, round_fraction;
+    std::vector<StreamBandwidth> sb;
+    for (int r = 0; r < rounds; ++r) {
+        std::vector<double> t = time_calls(opts.seconds / rounds, call);
+        if (opts.stream) {
+            StreamOptions so;
+            so.repetitions = 3;
+            sb.push_back(measure_stream_bandwidth(*opts.exec.executor(), so));
+            round_fraction.push_back(traffic.compulsory / median_of_sorted(t) / sb.back().triad);
+        }
+        ns.insert(ns.end(), t.begin(), t.end());
+    }
+    std::sort(ns.begin(), ns.end());
     const double median = median_of_sorted(ns);
     const double tets = mesh.num_tets();
-    // After the timed calls, on the kernels' executor (same back-end and
-    // threads), with the kernel's data still allocated.
-    StreamBandwidth stream;
-    if (opts.stream) stream = measure_stream_bandwidth(*opts.exec.executor());
+    // The median over the rounds of one STREAM rate.
+    const auto stream_median = [&](double StreamBandwidth::*rate) {
+        std::vector<double> v;
+        for (const auto& b : sb) v.push_back(b.*rate);
+        std::sort(v.begin(), v.end());
+        return median_of_sorted(v);
+    };
 
     print_header(opts, mesh);
     print_kv("calls", ns.size());
@@ -162,18 +186,28 @@ void run_bench(const BenchOptions& opts) {
         print_kv("achieved_GB_per_s_per_pass", fmt(traffic.per_pass / median, 6));
     }
     if (opts.stream) {
-        print_kv("stream_threads", stream.threads);
-        print_kv("stream_copy_GB_per_s", fmt(stream.copy, 6));
-        print_kv("stream_scale_GB_per_s", fmt(stream.scale, 6));
-        print_kv("stream_add_GB_per_s", fmt(stream.add, 6));
-        print_kv("stream_triad_GB_per_s", fmt(stream.triad, 6));
-        print_kv("stream_sum_GB_per_s", fmt(stream.sum, 6));
-        print_kv("stream_triad_best_GB_per_s", fmt(stream.triad_best, 6));
+        const double triad = stream_median(&StreamBandwidth::triad);
+        double triad_best = 0;
+        for (const auto& b : sb) triad_best = std::max(triad_best, b.triad_best);
+        print_kv("stream_threads", sb.front().threads);
+        print_kv("stream_rounds", rounds);
+        print_kv("stream_copy_GB_per_s", fmt(stream_median(&StreamBandwidth::copy), 6));
+        print_kv("stream_scale_GB_per_s", fmt(stream_median(&StreamBandwidth::scale), 6));
+        print_kv("stream_add_GB_per_s", fmt(stream_median(&StreamBandwidth::add), 6));
+        print_kv("stream_triad_GB_per_s", fmt(triad, 6));
+        print_kv("stream_sum_GB_per_s", fmt(stream_median(&StreamBandwidth::sum), 6));
+        print_kv("stream_triad_best_GB_per_s", fmt(triad_best, 6));
         if (traffic.compulsory > 0) {
-            print_kv("fraction_of_stream", fmt(achieved / stream.triad, 4));
+            print_kv("fraction_of_stream", fmt(achieved / triad, 4));
+            // Each round's median call against the triad right after it.
+            std::string each;
+            for (double f : round_fraction) each += (each.empty() ? "" : " ") + fmt(f, 4);
+            print_kv("fraction_of_stream_rounds", each);
+            std::sort(round_fraction.begin(), round_fraction.end());
+            print_kv("fraction_of_stream_paired", fmt(median_of_sorted(round_fraction), 4));
             // Fastest call against fastest triad: the least disturbed pair on
             // a shared machine (STREAM itself reports best times).
-            print_kv("fraction_of_stream_best", fmt(traffic.compulsory / ns.front() / stream.triad_best, 4));
+            print_kv("fraction_of_stream_best", fmt(traffic.compulsory / ns.front() / triad_best, 4));
         }
     }
 }
@@ -198,10 +232,17 @@ void add_bench_command(CLI::App& app) {
                     "--cg-iters iterations), successive steps from the moving state")
         ->required()
         ->check(CLI::IsMember({"force", "stiffness", "force+stiffness", "kx", "step"}));
-    cmd->add_flag("--stream", opts->stream,
-                  "Also measure the STREAM bandwidth (copy, scale, add, triad, read-only sum; 3 x 64 MiB, median of 7) "
-                  "on the same back-end and threads after the timed calls, and print the kernel's fraction of the "
-                  "triad rate (edge force and kx: bytes_per_call / median time)");
+    auto* stream_flag = cmd->add_flag("--stream", opts->stream,
+                  "Also measure the STREAM bandwidth (copy, scale, add, triad, read-only sum; 3 x 64 MiB) on the same "
+                  "back-end and threads, alternating with the timed calls (--stream-rounds), and print the kernel's "
+                  "fraction of the triad rate (edge force and kx: bytes_per_call / median time)");
+    cmd->add_option("--stream-rounds", opts->stream_rounds,
+                    "With --stream: alternate the timed calls (--seconds split evenly) and STREAM (median of 3) this "
+                    "many times; fraction_of_stream_paired is the median over the rounds of each round's median call "
+                    "against the triad measured right after it")
+        ->check(CLI::PositiveNumber)
+        ->needs(stream_flag)
+        ->capture_default_str();
     cmd->add_option("--cg-iters", opts->cg_iters,
                     "step: run exactly N warm-started CG iterations per step instead of solving to 1e-6")
         ->check(CLI::PositiveNumber);
