@@ -569,6 +569,7 @@ void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& s
     double* g = st.g.data();
     const index_t P = vs.parts();
     const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
+    const bool far = form_.tiles.size() > 1;  // core's tiles: the mesh exceeds the cache
     ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
         const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
         const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
@@ -585,8 +586,16 @@ void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& s
                 const FormTile& t = owner_tiles_[i];
                 kernel::edge_strain_range(m, u, prev.edge_end, t.edge_end, p, zeta, g);
                 const index_t split = std::clamp(form_spill_first_[q], prev.batch_end, t.batch_end);
-                for (index_t b = prev.batch_end; b < split; ++b) kernel::tet_form_strain(form_, b, zeta, g);
-                for (index_t b = split; b < t.batch_end; ++b) kernel::tet_form_strain(form_, b, zeta, gout);
+                // Rows and ids fetched ahead non-temporally on a mesh larger
+                // than the cache (kernel::prefetch_form_batch).
+                for (index_t b = prev.batch_end; b < split; ++b) {
+                    if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
+                    kernel::tet_form_strain(form_, b, zeta, g);
+                }
+                for (index_t b = split; b < t.batch_end; ++b) {
+                    if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
+                    kernel::tet_form_strain(form_, b, zeta, gout);
+                }
                 for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
                 prev = t;
             }
@@ -630,6 +639,7 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
         const ForwardSpill& fs = fspill_;
         const index_t P = fs.parts();
         const index_t phase_first[3] = {0, P, 2 * P};
+        const bool far = form_.tiles.size() > 1;
         ex_->for_phases(2, phase_first, [&](int phase, index_t q) {
             const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
             if (phase == 0) {  // tile by tile (FormTile): the edge terms, then the batches
@@ -639,8 +649,14 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
                     const index_t e1 = std::max(e0, owner_tiles_[t].edge_end), b1 = owner_tiles_[t].batch_end;
                     for (index_t i = e0; i < e1; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
                     const index_t split = std::clamp(form_spill_first_[q], b0, b1);
-                    for (index_t b = b0; b < split; ++b) kernel::tet_form_stiffness(form_, b, p, K);
-                    for (index_t b = split; b < b1; ++b) kernel::tet_form_stiffness(form_, b, p, kout);
+                    for (index_t b = b0; b < split; ++b) {
+                        if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
+                        kernel::tet_form_stiffness(form_, b, p, K);
+                    }
+                    for (index_t b = split; b < b1; ++b) {
+                        if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
+                        kernel::tet_form_stiffness(form_, b, p, kout);
+                    }
                     e0 = e1;
                     b0 = b1;
                 }
