@@ -10,6 +10,7 @@
 
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/make_box.hpp"
 #include "edgefem/core/tet_edge_form.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
@@ -99,7 +100,7 @@ Mesh shuffled(const Mesh& mesh, unsigned seed) {
 }
 
 template <class S>
-void tiles_bitwise(const Mesh& mesh, const std::string& name) {
+void tiles_bitwise(const Mesh& mesh, const std::string& name, int& rings) {
     const Materials mat(Material{1e5, 0.3, 1000});
     const auto m = test::make_models<S>(mesh, mat);
     TetEdgeForm<S> form = make_tet_edge_form<S>(mesh, m.topo, mat);
@@ -130,17 +131,58 @@ void tiles_bitwise(const Mesh& mesh, const std::string& name) {
         EXPECT_TRUE(s1.g == s0.g);
         EXPECT_TRUE(K1.K == K0.K);
         EXPECT_EQ(W1, W0);
+        // Without the state: the same sweep on a ring (small tiles wrap it
+        // many times), bitwise.
+        FormRing<S> ring = make_form_ring(form, m.edge.edge_first);
+        if (form.tiles.size() < 2) {
+            EXPECT_TRUE(ring.empty());
+            continue;
+        }
+        if (ring.empty()) continue;  // the ring would not be shorter than the edge list
+        EXPECT_GE(index_t(ring.g.size()), form_live_edges(form, m.edge.edge_first));
+        EXPECT_LT(index_t(ring.g.size()), m.edge.num_edges());
+        std::vector<S> f2(u.size(), S(7));
+        const double W2 = tet_form_forces_ring<ModelKind::FE, true>(m.edge, form, u.data(), f2.data(), ring);
+        EXPECT_TRUE(f2 == f0);
+        EXPECT_EQ(W2, W0);
+        ++rings;
     }
 }
 
 }  // namespace
 
 TEST(TetEdgeForm, TilesAreBitwiseTheWholeMeshPasses) {
+    int rings = 0;
     for (const auto& [name, mesh] : test::test_meshes(10000)) {
-        tiles_bitwise<double>(mesh, name);
-        tiles_bitwise<double>(shuffled(mesh, 7), name + " shuffled");
-        tiles_bitwise<float>(mesh, name);
+        tiles_bitwise<double>(mesh, name, rings);
+        tiles_bitwise<double>(shuffled(mesh, 7), name + " shuffled", rings);
+        tiles_bitwise<float>(mesh, name, rings);
     }
+    EXPECT_GT(rings, 0);  // the ring path ran
+}
+
+TEST(TetEdgeForm, RingMustFitTheTiles) {
+    const Mesh mesh = make_box(24, 8, 8, 0.01);  // a ring is shorter than its edge list
+    const Materials mat(Material{1e5, 0.3, 1000});
+    const auto m = test::make_models<double>(mesh, mat);
+    auto form = make_tet_edge_form<double>(mesh, m.topo, mat);
+    const auto u = deformation_displacement(mesh, Deformation::Random);
+    std::vector<double> f(u.size());
+    form.tiles = plan_form_tiles(form, m.topo.edges, m.topo.first_edge, 1);
+    FormRing<double> ring = make_form_ring(form, m.edge.edge_first);
+    ASSERT_FALSE(ring.empty());
+    EXPECT_NO_THROW((tet_form_forces_ring<ModelKind::FE, false>(m.edge, form, u.data(), f.data(), ring)));
+    // Larger tiles keep more edges alive than the ring holds.
+    for (index_t per_tile = 2; per_tile < form.num_batches(); per_tile *= 2) {
+        form.tiles = plan_form_tiles(form, m.topo.edges, m.topo.first_edge, per_tile);
+        if (form_live_edges(form, m.edge.edge_first) > index_t(ring.g.size())) break;
+    }
+    ASSERT_GT(form.tiles.size(), 1u);
+    ASSERT_GT(form_live_edges(form, m.edge.edge_first), index_t(ring.g.size()));
+    EXPECT_THROW((tet_form_forces_ring<ModelKind::FE, false>(m.edge, form, u.data(), f.data(), ring)), InvalidArgument);
+    form.tiles.clear();  // one tile: no ring at all
+    EXPECT_TRUE(make_form_ring(form, m.edge.edge_first).empty());
+    EXPECT_THROW((tet_form_forces_ring<ModelKind::FE, false>(m.edge, form, u.data(), f.data(), ring)), InvalidArgument);
 }
 
 TEST(TetEdgeForm, TilePlanRejectsNonsense) {

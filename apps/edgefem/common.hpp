@@ -129,8 +129,10 @@ public:
     virtual void prepare(Kernel kernel, const std::vector<double>& x) = 0;
     virtual void run(Kernel kernel) = 0;
     virtual void consume() = 0;
-    // The operator's ElasticOperator::forces_from_tet_local_form().
+    // The operator's ElasticOperator::forces_from_tet_local_form() and
+    // forces_stored_state().
     virtual bool forces_from_tet_local_form() const = 0;
+    virtual bool forces_stored_state() const = 0;
 };
 
 // Builds the chosen model for `mesh` (opts must be validated) on the chosen

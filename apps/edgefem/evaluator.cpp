@@ -36,6 +36,7 @@ public:
     // precomputed K.
     void prepare(Kernel kernel, const std::vector<double>& x) override {
         x_.assign(x.begin(), x.end());
+        op_->keep_state(kernel != Kernel::Force);  // a force-only loop builds no K
         if (kernel == Kernel::Stiffness || kernel == Kernel::Kx) op_->forces(u_.data(), f_.data(), false);
         if (kernel == Kernel::Kx) op_->build_stiffness(false);
     }
@@ -55,6 +56,7 @@ public:
         escape(y_.data());
     }
     bool forces_from_tet_local_form() const override { return op_->forces_from_tet_local_form(); }
+    bool forces_stored_state() const override { return op_->forces_stored_state(); }
 
 private:
     std::unique_ptr<ElasticOperator<S>> op_;

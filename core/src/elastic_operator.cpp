@@ -20,20 +20,36 @@ public:
         if (Kind == ModelKind::FE && layout == StiffnessLayout::TetLocal) {
             form_ = make_tet_edge_form<S>(mesh, topo, materials);
             model_.target = {};  // the TSEP targets serve only the TSEP-list stiffness
+            ring_ = make_form_ring(form_, model_.edge_first);
         }
         state_.resize(model_.num_edges());
         K_.resize(model_.num_edges());
         scratch_.resize(3 * std::size_t(model_.num_vertices));
+        u_last_.resize(3 * std::size_t(model_.num_vertices));
     }
     index_t num_vertices() const override { return model_.num_vertices; }
     // With the tet-local form, its g pass replaces the TSEP loop in the
     // forces too (same terms, another summation order: bench_kernels
     // force/edge-fe-tetform, 1.1-1.35x faster on bunny-4k and armadillo-7k).
+    // u is kept, so that build_stiffness() can rebuild the state when the
+    // last forces() call did not leave it (keep_state(false), on the ring)
+    // or energy() has overwritten it since.
     double forces(const S* u, S* f, bool energy) override {
-        return energy ? forces_with<true>(u, f) : forces_with<false>(u, f);
+        std::copy(u, u + u_last_.size(), u_last_.begin());
+        const bool ring = !keep_state_ && !ring_.empty();
+        state_stale_ = last_on_ring_ = ring;
+        return energy ? forces_with<true>(u, f, ring) : forces_with<false>(u, f, ring);
     }
-    double energy(const S* u) override { return forces_with<true>(u, scratch_.data()); }
+    double energy(const S* u) override {
+        if (ring_.empty()) state_stale_ = true;
+        return forces_with<true>(u, scratch_.data(), !ring_.empty());
+    }
+    void keep_state(bool keep) override { keep_state_ = keep; }
     void build_stiffness(bool definite) override {
+        if (state_stale_) {
+            forces_with<false>(u_last_.data(), scratch_.data(), false);
+            state_stale_ = false;
+        }
         if (form_.num_tets > 0) {
             if (definite)
                 tet_form_stiffness_all<Kind, true>(model_, form_, state_, K_);
@@ -62,10 +78,13 @@ public:
     }
     index_t inverted_tets(const S* u) const override { return count_inverted_tets(mesh_, u); }
     bool forces_from_tet_local_form() const override { return form_.num_tets > 0; }
+    bool forces_stored_state() const override { return !last_on_ring_; }
 
 private:
+    // `ring`: on ring_, leaving state_ as it is.
     template <bool Energy>
-    double forces_with(const S* u, S* f) {
+    double forces_with(const S* u, S* f, bool ring) {
+        if (ring) return tet_form_forces_ring<Kind, Energy>(model_, form_, u, f, ring_);
         if (form_.num_tets > 0) return tet_form_forces<Kind, Energy>(model_, form_, u, f, state_);
         return edge_forces<Kind, Energy>(model_, u, f, state_);
     }
@@ -74,6 +93,9 @@ private:
     EdgeModel<S> model_;
     TetEdgeForm<S> form_;  // empty unless FE with the tet-local layout
     EdgeState<S> state_;
+    FormRing<S> ring_;  // empty unless the form runs in tiles (make_form_ring)
+    bool keep_state_ = true, state_stale_ = false, last_on_ring_ = false;
+    std::vector<S> u_last_;  // u of the last forces() call
     EdgeStiffness<S> K_;
     std::vector<S> scratch_;
 };

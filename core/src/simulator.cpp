@@ -189,6 +189,7 @@ struct Simulator<S>::Impl {
         };
         const Mesh& mesh = scene.mesh;
         op = factory(mesh, scene.materials, scene.model, scene.method);
+        if (scene.integrator == Integrator::Explicit) op->keep_state(false);  // explicit steps never build K
         mass = edgefem::lumped_mass(mesh, scene.materials);
         mass_dof.resize(3 * mass.size());
         for (std::size_t i = 0; i < mass_dof.size(); ++i) mass_dof[i] = mass[i / 3];

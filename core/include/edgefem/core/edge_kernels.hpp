@@ -35,6 +35,17 @@ struct EdgeState {
     }
 };
 
+// Where the per-edge state of edge e sits: at e (EdgeState's mesh-wide
+// arrays) or at e & mask (a power-of-two ring, FormRing in
+// tet_edge_form.hpp, for force calls that keep no state).
+struct EdgeSlot {
+    index_t operator()(index_t e) const { return e; }
+};
+struct RingSlot {
+    index_t mask;
+    index_t operator()(index_t e) const { return e & mask; }
+};
+
 // Per-edge 3x3 blocks K(E) (row-major, 9 per edge) plus one sink block.
 template <class S>
 struct EdgeStiffness {
@@ -48,30 +59,33 @@ struct EdgeStiffness {
 namespace kernel {
 
 // Edge loop worker: p~(E), zeta(E) and g(E) = L(E) zeta(E).
-template <class S>
+// The state goes to slot(e) (EdgeSlot: e).
+template <class S, class Slot = EdgeSlot>
 EDGEFEM_KERNEL void edge_strain(const EdgeModel<S>& m, const S* __restrict u, index_t e, S* __restrict p,
-                        S* __restrict zeta, double* __restrict g) {
+                        S* __restrict zeta, double* __restrict g, Slot slot = {}) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     const S* r = &m.rest[3 * std::size_t(e)];
     const S d0 = u[3 * a] - u[3 * b], d1 = u[3 * a + 1] - u[3 * b + 1], d2 = u[3 * a + 2] - u[3 * b + 2];
     const S q0 = r[0] + d0, q1 = r[1] + d1, q2 = r[2] + d2;
     const S z = d0 * (r[0] + q0) + d1 * (r[1] + q1) + d2 * (r[2] + q2);
-    p[3 * std::size_t(e)] = q0;
-    p[3 * std::size_t(e) + 1] = q1;
-    p[3 * std::size_t(e) + 2] = q2;
-    zeta[e] = z;
-    g[e] = m.LE[e] * z;
+    const index_t k = slot(e);
+    p[3 * std::size_t(k)] = q0;
+    p[3 * std::size_t(k) + 1] = q1;
+    p[3 * std::size_t(k) + 2] = q2;
+    zeta[k] = z;
+    g[k] = m.LE[e] * z;
 }
 
 // The edge loop over edges [e0, e1), out of line and scalar
 // (EDGEFEM_SCALAR_LOOP says why).
-template <class S>
+template <class S, class Slot = EdgeSlot>
 EDGEFEM_SCALAR_LOOP void edge_strain_range(const EdgeModel<S>& m, const S* __restrict u, index_t e0, index_t e1,
-                                           S* __restrict p, S* __restrict zeta, double* __restrict g) {
+                                           S* __restrict p, S* __restrict zeta, double* __restrict g,
+                                           Slot slot = {}) {
 #if defined(__clang__)
 #pragma clang loop vectorize(disable)
 #endif
-    for (index_t e = e0; e < e1; ++e) edge_strain(m, u, e, p, zeta, g);
+    for (index_t e = e0; e < e1; ++e) edge_strain(m, u, e, p, zeta, g, slot);
 }
 
 // V1 of edge e through a local restrict pointer to the edge list: read
@@ -189,12 +203,14 @@ EDGEFEM_KERNEL void edge_force_terms(const S* __restrict p, index_t e, S gs, S& 
 // Edge scatter over the segment of edges whose V0 is `a`: f(a) gets the
 // segment's sum from registers (edges are sorted by V0, so a per-edge
 // f(V0) += ... would chain stores to one address); each f(V1) -= p~ g.
-template <class S>
+template <class S, class Slot = EdgeSlot>
 EDGEFEM_KERNEL void edge_force_segment(const EdgeModel<S>& m, index_t a, const S* __restrict p, const double* __restrict g,
-                               S* __restrict f, const ForwardOut<S>& out) {
+                               S* __restrict f, const ForwardOut<S>& out, Slot slot = {}) {
     S acc0 = 0, acc1 = 0, acc2 = 0;
-    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], second_vertex(m), out,
-                   [&](index_t e, S* fb) { edge_force_terms(p, e, S(g[e]), acc0, acc1, acc2, fb); });
+    for_segment<3>(m.edge_first[a], m.edge_first[a + 1], second_vertex(m), out, [&](index_t e, S* fb) {
+        const index_t k = slot(e);
+        edge_force_terms(p, k, S(g[k]), acc0, acc1, acc2, fb);
+    });
     f[3 * std::size_t(a)] += acc0;
     f[3 * std::size_t(a) + 1] += acc1;
     f[3 * std::size_t(a) + 2] += acc2;

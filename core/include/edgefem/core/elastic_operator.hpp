@@ -37,6 +37,12 @@ public:
     virtual double forces(const S* u, S* f, bool energy) = 0;
     // W at u, without forces.
     virtual double energy(const S* u) = 0;
+    // A hint: whether a build_stiffness() may follow forces() (true until
+    // told otherwise). A caller that never builds K (explicit steps, a force
+    // benchmark) says false, and an operator may then skip storing the
+    // state K would be built from; build_stiffness() stays correct either
+    // way (it recomputes what it lacks).
+    virtual void keep_state(bool /*keep*/) {}
     // K at the configuration of the last forces() call. `definite` clamps
     // g(E) at zero inside K (edge method only): K becomes positive
     // semi-definite, the forces are unchanged.
@@ -56,6 +62,10 @@ public:
     // Whether forces() takes g(E) from the tet-local form rather than the
     // TSEP list: which arrays a force call streams (stream_bandwidth.hpp).
     virtual bool forces_from_tet_local_form() const { return false; }
+    // Whether the last forces() call stored its per-edge state (p~, zeta,
+    // g) in mesh-wide arrays, i.e. wrote it to memory on a large mesh
+    // (stream_bandwidth.hpp counts those bytes only then).
+    virtual bool forces_stored_state() const { return true; }
 };
 
 // Throws InvalidArgument for SN with the per-tet method.

@@ -22,3 +22,13 @@
 #else
 #define EDGEFEM_SCALAR_LOOP
 #endif
+
+// EDGEFEM_LOOP marks an out-of-line batch loop: its own function keeps the
+// code around it as compiled without it (a second, prefetching copy of the
+// g pass inlined next to the plain one made the plain one 7 % slower on
+// bunny-4k).
+#if defined(__GNUC__) || defined(__clang__)
+#define EDGEFEM_LOOP __attribute__((noinline))
+#else
+#define EDGEFEM_LOOP
+#endif

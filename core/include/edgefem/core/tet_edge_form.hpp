@@ -28,6 +28,7 @@
 
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/edge_kernels.hpp"
+#include "edgefem/core/error.hpp"
 #include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh.hpp"
 #include "edgefem/core/topology.hpp"
@@ -193,16 +194,18 @@ struct DoubleLanes {
 // parallel variant's window past its part). The serial form keeps plain
 // restrict-qualified g updates: through kernel::ForwardOut or a lambda it
 // measured 5-10 % slower.
-template <bool Spill, class S>
+// zeta and g of edge e sit at slot(e) (Spill: EdgeSlot only).
+template <bool Spill, class S, class Slot = EdgeSlot>
 inline void tet_form_strain_impl(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g,
-                                 double* __restrict spill, index_t end) {
+                                 double* __restrict spill, index_t end, Slot slot = {}) {
+    static_assert(!Spill || std::is_same_v<Slot, EdgeSlot>, "spill windows index the mesh-wide state");
     constexpr int L = kTetLanes<S>, G = L < 4 ? L : 4;
     using V = typename DoubleLanes<G>::type;
     const auto add = [&](index_t e, double v) {
         if constexpr (Spill)
             (e < end ? g[e] : spill[e - end]) += v;
         else
-            g[e] += v;
+            g[slot(e)] += v;
     };
     const int n = f.batch_size(b);
     for (int h = 0; h < n; h += G) {
@@ -211,7 +214,7 @@ inline void tet_form_strain_impl(const TetEdgeForm<S>& f, index_t b, const S* __
         V Z[6];
         for (int k = 0; k < 6; ++k) {
             double z[G];  // lanes through an array: per-lane writes into Z[k] warn (-Wmaybe-uninitialized)
-            for (int l = 0; l < G; ++l) z[l] = double(zeta[E[k * L + l]]);
+            for (int l = 0; l < G; ++l) z[l] = double(zeta[slot(E[k * L + l])]);
             __builtin_memcpy(&Z[k], z, sizeof(V));
         }
 #pragma GCC unroll 6
@@ -259,6 +262,29 @@ EDGEFEM_KERNEL void prefetch_form_batch(const TetEdgeForm<S>& f, index_t b) {
 template <class S>
 inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g) {
     tet_form_strain_impl<false>(f, b, zeta, g, nullptr, 0);
+}
+// The g pass over batches [b0, b1), each batch's rows and ids fetched
+// kFormPrefetchBatches ahead when `Prefetch`; out of line (EDGEFEM_LOOP).
+template <bool Prefetch, class S, class Slot>
+EDGEFEM_LOOP void tet_form_strain_batches(const TetEdgeForm<S>& f, index_t b0, index_t b1, const S* __restrict zeta,
+                                          double* __restrict g, Slot slot) {
+    for (index_t b = b0; b < b1; ++b) {
+        if constexpr (Prefetch) prefetch_form_batch(f, b + kFormPrefetchBatches);
+        tet_form_strain_impl<false>(f, b, zeta, g, nullptr, 0, slot);
+    }
+}
+template <bool Prefetch, class S>
+EDGEFEM_LOOP void tet_form_strain_batches(const TetEdgeForm<S>& f, index_t b0, index_t b1, const S* __restrict zeta,
+                                          const ForwardOut<double>& out) {
+    for (index_t b = b0; b < b1; ++b) {
+        if constexpr (Prefetch) prefetch_form_batch(f, b + kFormPrefetchBatches);
+        tet_form_strain_impl<true>(f, b, zeta, out.direct, out.spill, out.end);
+    }
+}
+template <class S>
+inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g,
+                            RingSlot slot) {
+    tet_form_strain_impl<false>(f, b, zeta, g, nullptr, 0, slot);
 }
 template <class S>
 inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, const ForwardOut<double>& out) {
@@ -377,6 +403,24 @@ template <class S>
 inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __restrict p, const ForwardOut<S>& out) {
     tet_form_stiffness_impl<true>(f, b, p, out.direct, out.spill, out.end);
 }
+// The stiffness pair terms of batches [b0, b1) with the rows and ids fetched
+// ahead (tet_form_strain_batches), into K or through `out`.
+template <class S>
+EDGEFEM_LOOP void tet_form_stiffness_batches_prefetched(const TetEdgeForm<S>& f, index_t b0, index_t b1,
+                                                        const S* __restrict p, S* __restrict K) {
+    for (index_t b = b0; b < b1; ++b) {
+        prefetch_form_batch(f, b + kFormPrefetchBatches);
+        tet_form_stiffness_impl<false>(f, b, p, K, static_cast<S*>(nullptr), 0);
+    }
+}
+template <class S>
+EDGEFEM_LOOP void tet_form_stiffness_batches_prefetched(const TetEdgeForm<S>& f, index_t b0, index_t b1,
+                                                        const S* __restrict p, const ForwardOut<S>& out) {
+    for (index_t b = b0; b < b1; ++b) {
+        prefetch_form_batch(f, b + kFormPrefetchBatches);
+        tet_form_stiffness_impl<true>(f, b, p, out.direct, out.spill, out.end);
+    }
+}
 
 }  // namespace kernel
 
@@ -398,31 +442,98 @@ void for_form_tiles(const TetEdgeForm<S>& form, index_t num_edges, index_t num_v
 }
 
 // The three passes (edge loop, g pass over the batches, edge scatter) run
-// tile by tile (FormTile). The g pass and the scatter were also tried fused
-// in one sweep over the vertices: 5-10 % slower on bunny-4k and
-// armadillo-7k (bench_kernels, three runs).
+// tile by tile (FormTile), on state arrays indexed through `slot`. The g
+// pass and the scatter were also tried fused in one sweep over the
+// vertices: 5-10 % slower on bunny-4k and armadillo-7k (bench_kernels,
+// three runs).
+template <ModelKind Kind, bool Energy, class S, class Slot>
+double tet_form_forces_on(const EdgeModel<S>& m, const TetEdgeForm<S>& form, const S* u, S* f, S* p, S* zeta,
+                          double* g, Slot slot) {
+    double W = 0;
+    const bool tiled = form.tiles.size() > 1;
+    const kernel::ForwardOut<S> out = kernel::direct_only(f);
+    for_form_tiles(form, m.num_edges(), m.num_vertices, [&](const FormTile& t, const FormTile& prev) {
+        kernel::edge_strain_range(m, u, prev.edge_end, t.edge_end, p, zeta, g, slot);
+        if constexpr (Kind == ModelKind::FE) {
+            if (tiled)
+                kernel::tet_form_strain_batches<true>(form, prev.batch_end, t.batch_end, zeta, g, slot);
+            else
+                for (index_t b = prev.batch_end; b < t.batch_end; ++b)
+                    kernel::tet_form_strain_impl<false>(form, b, zeta, g, nullptr, 0, slot);
+        }
+        std::fill(f + 3 * std::size_t(prev.zero_end), f + 3 * std::size_t(t.zero_end), S(0));
+        if constexpr (std::is_same_v<Slot, EdgeSlot>)
+            for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f);
+        else
+            for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f, out, slot);
+        if constexpr (Energy)
+            for (index_t e = m.edge_first[prev.vertex_end]; e < m.edge_first[t.vertex_end]; ++e)
+                W += double(zeta[slot(e)]) * g[slot(e)];
+    });
+    return 0.25 * W;
+}
+
+// Forces (and the energy when `Energy`); leaves p~, zeta, g in `st` for
+// tet_form_stiffness_all.
 template <ModelKind Kind, bool Energy, class S>
 double tet_form_forces(const EdgeModel<S>& m, const TetEdgeForm<S>& form, const S* u, S* f, EdgeState<S>& st) {
     st.resize(m.num_edges());
-    S* p = st.p.data();
-    S* zeta = st.zeta.data();
-    double* g = st.g.data();
-    double W = 0;
-    const bool tiled = form.tiles.size() > 1;
-    for_form_tiles(form, m.num_edges(), m.num_vertices, [&](const FormTile& t, const FormTile& prev) {
-        kernel::edge_strain_range(m, u, prev.edge_end, t.edge_end, p, zeta, g);
-        if constexpr (Kind == ModelKind::FE)
-            for (index_t b = prev.batch_end; b < t.batch_end; ++b) {
-                if (tiled) kernel::prefetch_form_batch(form, b + kernel::kFormPrefetchBatches);
-                kernel::tet_form_strain(form, b, zeta, g);
-            }
-        std::fill(f + 3 * std::size_t(prev.zero_end), f + 3 * std::size_t(t.zero_end), S(0));
-        for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f);
-        if constexpr (Energy)
-            for (index_t e = m.edge_first[prev.vertex_end]; e < m.edge_first[t.vertex_end]; ++e)
-                W += double(zeta[e]) * g[e];
-    });
-    return 0.25 * W;
+    return tet_form_forces_on<Kind, Energy>(m, form, u, f, st.p.data(), st.zeta.data(), st.g.data(), EdgeSlot{});
+}
+
+// The edge state of a force call that keeps none: a ring of a power of two
+// slots (edge e at e & mask), at least as long as the longest stretch of
+// edges alive at once in the tiles (from the first edge of the first
+// segment still to scatter to the last edge strained). On a mesh larger
+// than the cache the mesh-wide state is written back to memory after each
+// tile (40 bytes per edge, plus the write-allocate reads); the ring stays
+// cached. Empty (unused) when the form has one tile or the ring would not
+// be shorter than the edge list.
+template <class S>
+struct FormRing {
+    RingSlot slot{0};
+    std::vector<S> p, zeta;
+    std::vector<double> g;
+    bool empty() const { return g.empty(); }
+};
+// The longest stretch of edges alive at once in the form's tiles (0 for
+// one tile); edge_first as EdgeModel::edge_first.
+template <class S>
+index_t form_live_edges(const TetEdgeForm<S>& form, const std::vector<index_t>& edge_first) {
+    index_t live = 0, first_vertex = 0;
+    if (form.tiles.size() > 1)
+        for (const FormTile& t : form.tiles) {
+            live = std::max(live, t.edge_end - edge_first[first_vertex]);
+            first_vertex = t.vertex_end;
+        }
+    return live;
+}
+template <class S>
+FormRing<S> make_form_ring(const TetEdgeForm<S>& form, const std::vector<index_t>& edge_first) {
+    FormRing<S> r;
+    const index_t live = form_live_edges(form, edge_first);
+    if (live == 0) return r;
+    index_t n = 1;
+    while (n < live) n *= 2;
+    if (n >= form.num_edges) return r;
+    r.slot = RingSlot{n - 1};
+    r.p.resize(3 * std::size_t(n));
+    r.zeta.resize(n);
+    r.g.resize(n);
+    return r;
+}
+
+// tet_form_forces without the state: the same operations in the same order
+// (bitwise the same forces and energy) on the ring; a stiffness needs
+// tet_form_forces. bench (standalone, 1 thread, RCM, medians of 21 paired
+// rounds): bunny-1m 0.93-0.95 of tet_form_forces' time.
+template <ModelKind Kind, bool Energy, class S>
+double tet_form_forces_ring(const EdgeModel<S>& m, const TetEdgeForm<S>& form, const S* u, S* f, FormRing<S>& ring) {
+    // O(tiles) per call: a ring made for other tiles would overwrite live slots.
+    const index_t live = form_live_edges(form, m.edge_first);
+    if (ring.empty() || live == 0 || live > ring.slot.mask + 1)
+        throw InvalidArgument("tet_form_forces_ring: the ring does not fit the form's tiles (make_form_ring)");
+    return tet_form_forces_on<Kind, Energy>(m, form, u, f, ring.p.data(), ring.zeta.data(), ring.g.data(), ring.slot);
 }
 
 template <ModelKind Kind, bool Definite = false, class S>
@@ -436,11 +547,12 @@ void tet_form_stiffness_all(const EdgeModel<S>& m, const TetEdgeForm<S>& form, c
     const bool tiled = form.tiles.size() > 1;
     for_form_tiles(form, ne, m.num_vertices, [&](const FormTile& t, const FormTile& prev) {
         for (index_t e = prev.edge_end; e < t.edge_end; ++e) kernel::edge_stiffness<Definite>(m, e, p, g, Kv);
-        if constexpr (Kind == ModelKind::FE)
-            for (index_t b = prev.batch_end; b < t.batch_end; ++b) {
-                if (tiled) kernel::prefetch_form_batch(form, b + kernel::kFormPrefetchBatches);
-                kernel::tet_form_stiffness(form, b, p, Kv);
-            }
+        if constexpr (Kind == ModelKind::FE) {
+            if (tiled)
+                kernel::tet_form_stiffness_batches_prefetched(form, prev.batch_end, t.batch_end, p, Kv);
+            else
+                for (index_t b = prev.batch_end; b < t.batch_end; ++b) kernel::tet_form_stiffness(form, b, p, Kv);
+        }
     });
 }
 

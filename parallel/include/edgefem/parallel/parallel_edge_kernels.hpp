@@ -588,13 +588,12 @@ void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& s
                 const index_t split = std::clamp(form_spill_first_[q], prev.batch_end, t.batch_end);
                 // Rows and ids fetched ahead non-temporally on a mesh larger
                 // than the cache (kernel::prefetch_form_batch).
-                for (index_t b = prev.batch_end; b < split; ++b) {
-                    if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
-                    kernel::tet_form_strain(form_, b, zeta, g);
-                }
-                for (index_t b = split; b < t.batch_end; ++b) {
-                    if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
-                    kernel::tet_form_strain(form_, b, zeta, gout);
+                if (far) {
+                    kernel::tet_form_strain_batches<true>(form_, prev.batch_end, split, zeta, g, EdgeSlot{});
+                    kernel::tet_form_strain_batches<true>(form_, split, t.batch_end, zeta, gout);
+                } else {
+                    for (index_t b = prev.batch_end; b < split; ++b) kernel::tet_form_strain(form_, b, zeta, g);
+                    for (index_t b = split; b < t.batch_end; ++b) kernel::tet_form_strain(form_, b, zeta, gout);
                 }
                 for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f, fout);
                 prev = t;
@@ -649,13 +648,12 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
                     const index_t e1 = std::max(e0, owner_tiles_[t].edge_end), b1 = owner_tiles_[t].batch_end;
                     for (index_t i = e0; i < e1; ++i) kernel::edge_stiffness<Definite>(m, i, p, g, K);
                     const index_t split = std::clamp(form_spill_first_[q], b0, b1);
-                    for (index_t b = b0; b < split; ++b) {
-                        if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
-                        kernel::tet_form_stiffness(form_, b, p, K);
-                    }
-                    for (index_t b = split; b < b1; ++b) {
-                        if (far) kernel::prefetch_form_batch(form_, b + kernel::kFormPrefetchBatches);
-                        kernel::tet_form_stiffness(form_, b, p, kout);
+                    if (far) {
+                        kernel::tet_form_stiffness_batches_prefetched(form_, b0, split, p, K);
+                        kernel::tet_form_stiffness_batches_prefetched(form_, split, b1, p, kout);
+                    } else {
+                        for (index_t b = b0; b < split; ++b) kernel::tet_form_stiffness(form_, b, p, K);
+                        for (index_t b = split; b < b1; ++b) kernel::tet_form_stiffness(form_, b, p, kout);
                     }
                     e0 = e1;
                     b0 = b1;

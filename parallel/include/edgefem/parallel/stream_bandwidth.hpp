@@ -142,17 +142,20 @@ double force_bytes_per_call(const EdgeModel<S>& m, ModelKind kind = ModelKind::F
 // counts the state once, as written (p~ 3 #E S, zeta #E S, g #E double),
 // and the reads not at all. (The owner variant re-reads each part's head
 // after its barrier, which this leaves out: it counts too few bytes there,
-// never too many.)
+// never too many.) `state_stored` false: the call kept its state in a
+// cached ring (tet_form_forces_ring, only with tiles): Compulsory counts
+// none of it.
 template <class S>
 double form_force_bytes_per_call(const EdgeModel<S>& m, const TetEdgeForm<S>& form,
-                                 TrafficModel model = TrafficModel::Compulsory) {
+                                 TrafficModel model = TrafficModel::Compulsory, bool state_stored = true) {
     const auto bytes_of = [](const auto& v) { return detail::traffic_bytes_of(v); };
     const double E = m.num_edges(), s = sizeof(S);
     double b = force_bytes_per_call(m, ModelKind::SN, model);  // strains, scatter, p~ / zeta / g, u, f
     b += bytes_of(form.edge) + bytes_of(form.A);
-    if (model == TrafficModel::Compulsory && form.tiles.size() > 1)
+    if (model == TrafficModel::Compulsory && form.tiles.size() > 1) {
         b -= 3 * E * s + E * sizeof(double);  // p~ and g read back from the cache
-    else
+        if (!state_stored) b -= 3 * E * s + E * s + E * sizeof(double);  // nor written: a ring
+    } else
         b += E * s;  // zeta read by the form pass
     if (model == TrafficModel::PerPass) b += 2 * E * sizeof(double);
     return b;
