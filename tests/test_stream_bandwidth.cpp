@@ -181,4 +181,12 @@ TEST(StreamBandwidth, TrafficModelsCountTheArrays) {
     EXPECT_DOUBLE_EQ(form_force_bytes_per_call(md, form), sn + arrays - 3 * 8 * E - 8 * E);
     EXPECT_DOUBLE_EQ(form_force_bytes_per_call(md, form, TrafficModel::PerPass),
                      force_bytes_per_call(md, ModelKind::SN, TrafficModel::PerPass) + arrays + 8 * E + 2 * 8 * E);
+    // On a ring (tet_form_forces_ring) the state is not written either: the
+    // model arrays, the form, u and f are left.
+    const double V = md.num_vertices;
+    EXPECT_DOUBLE_EQ(form_force_bytes_per_call(md, form, TrafficModel::Compulsory, false),
+                     size_bytes(md.edge) + size_bytes(md.edge_first) + size_bytes(md.rest) + size_bytes(md.LE) + arrays +
+                         2 * 3 * 8 * V);
+    EXPECT_DOUBLE_EQ(form_force_bytes_per_call(md, form, TrafficModel::Compulsory, false),
+                     form_force_bytes_per_call(md, form) - (3 * 8 * E + 8 * E + 8 * E));
 }
