@@ -161,6 +161,7 @@ void BM_Paper(benchmark::State& state, std::string mesh_name, Kernel k, Which m,
         std::vector<S> u(ud.begin(), ud.end()), f(u.size());
         op->forces(u.data(), f.data(), false);
         op->build_stiffness(false);
+        op->keep_state(k != Kernel::Force);  // the force alone: no state for a K (the per-tet method keeps none)
         for (auto _ : state) {
             switch (k) {
                 case Kernel::Force: op->forces(u.data(), f.data(), false); break;
