@@ -31,23 +31,25 @@ public:
     // With the tet-local form, its g pass replaces the TSEP loop in the
     // forces too (same terms, another summation order: bench_kernels
     // force/edge-fe-tetform, 1.1-1.35x faster on bunny-4k and armadillo-7k).
-    // u is kept, so that build_stiffness() can rebuild the state when the
-    // last forces() call did not leave it (keep_state(false), on the ring)
-    // or energy() has overwritten it since.
+    // On the ring (keep_state(false)) u is kept, so that build_stiffness()
+    // can rebuild the state if it is asked for after all. (Copying u on
+    // every call cost bunny-4k's force 2-3 %.)
     double forces(const S* u, S* f, bool energy) override {
-        std::copy(u, u + u_last_.size(), u_last_.begin());
         const bool ring = !keep_state_ && !ring_.empty();
         state_stale_ = last_on_ring_ = ring;
-        return energy ? forces_with<true>(u, f, ring) : forces_with<false>(u, f, ring);
+        if (ring) std::copy(u, u + u_last_.size(), u_last_.begin());
+        return energy ? forces_with<true>(u, f, ring, state_) : forces_with<false>(u, f, ring, state_);
     }
+    // Never touches state_ (a K built after it is still at the last forces()
+    // call's u): on the ring, else on a state of its own.
     double energy(const S* u) override {
-        if (ring_.empty()) state_stale_ = true;
-        return forces_with<true>(u, scratch_.data(), !ring_.empty());
+        if (!ring_.empty()) return forces_with<true>(u, scratch_.data(), true, state_);
+        return forces_with<true>(u, scratch_.data(), false, energy_state_);
     }
     void keep_state(bool keep) override { keep_state_ = keep; }
     void build_stiffness(bool definite) override {
         if (state_stale_) {
-            forces_with<false>(u_last_.data(), scratch_.data(), false);
+            forces_with<false>(u_last_.data(), scratch_.data(), false, state_);
             state_stale_ = false;
         }
         if (form_.num_tets > 0) {
@@ -81,21 +83,22 @@ public:
     bool forces_stored_state() const override { return !last_on_ring_; }
 
 private:
-    // `ring`: on ring_, leaving state_ as it is.
+    // `ring`: on ring_, else leaving the state in `st`.
     template <bool Energy>
-    double forces_with(const S* u, S* f, bool ring) {
+    double forces_with(const S* u, S* f, bool ring, EdgeState<S>& st) {
         if (ring) return tet_form_forces_ring<Kind, Energy>(model_, form_, u, f, ring_);
-        if (form_.num_tets > 0) return tet_form_forces<Kind, Energy>(model_, form_, u, f, state_);
-        return edge_forces<Kind, Energy>(model_, u, f, state_);
+        if (form_.num_tets > 0) return tet_form_forces<Kind, Energy>(model_, form_, u, f, st);
+        return edge_forces<Kind, Energy>(model_, u, f, st);
     }
 
     const Mesh& mesh_;
     EdgeModel<S> model_;
     TetEdgeForm<S> form_;  // empty unless FE with the tet-local layout
     EdgeState<S> state_;
+    EdgeState<S> energy_state_;  // energy()'s, sized on first use (edge_forces resizes)
     FormRing<S> ring_;  // empty unless the form runs in tiles (make_form_ring)
     bool keep_state_ = true, state_stale_ = false, last_on_ring_ = false;
-    std::vector<S> u_last_;  // u of the last forces() call
+    std::vector<S> u_last_;  // u of the last forces() call on the ring
     EdgeStiffness<S> K_;
     std::vector<S> scratch_;
 };
