@@ -21,11 +21,11 @@ public:
             form_ = make_tet_edge_form<S>(mesh, topo, materials);
             model_.target = {};  // the TSEP targets serve only the TSEP-list stiffness
             ring_ = make_form_ring(form_, model_.edge_first);
+            if (!ring_.empty()) u_last_.resize(3 * std::size_t(model_.num_vertices));
         }
         state_.resize(model_.num_edges());
         K_.resize(model_.num_edges());
         scratch_.resize(3 * std::size_t(model_.num_vertices));
-        u_last_.resize(3 * std::size_t(model_.num_vertices));
     }
     index_t num_vertices() const override { return model_.num_vertices; }
     // With the tet-local form, its g pass replaces the TSEP loop in the

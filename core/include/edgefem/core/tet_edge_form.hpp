@@ -241,10 +241,10 @@ inline void tet_form_strain_impl(const TetEdgeForm<S>& f, index_t b, const S* __
 // Non-temporal prefetch of batch b's rows and edge ids (nothing past the
 // last batch), for the batch loops to issue kFormPrefetchBatches ahead when
 // the form runs in tiles (a mesh larger than the cache; one tile: not
-// issued). On such a mesh the
-// form streams through L2 and evicts the zeta, g (or K(E)) lines of the
-// tile's live window, which the next tiles read again (the RCM front: ~38k
-// edges on bunny-1m); lines fetched non-temporally displace little else.
+// issued). On such a mesh the form streams through L2 and evicts the zeta,
+// g (or K(E)) lines of the tile's live window, which the next tiles read
+// again (the RCM front: ~38k edges on bunny-1m); lines fetched
+// non-temporally displace little else.
 // bench (standalone A/B in one process, 1 thread, RCM, medians of 15-21
 // paired rounds): force on bunny-1m 0.96 of the time without, bunny-250k
 // 0.98; stiffness on bunny-1m 0.98.
@@ -264,27 +264,22 @@ inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restr
     tet_form_strain_impl<false>(f, b, zeta, g, nullptr, 0);
 }
 // The g pass over batches [b0, b1), each batch's rows and ids fetched
-// kFormPrefetchBatches ahead when `Prefetch`; out of line (EDGEFEM_LOOP).
-template <bool Prefetch, class S, class Slot>
-EDGEFEM_LOOP void tet_form_strain_batches(const TetEdgeForm<S>& f, index_t b0, index_t b1, const S* __restrict zeta,
-                                          double* __restrict g, Slot slot) {
+// kFormPrefetchBatches ahead; out of line (EDGEFEM_LOOP says why).
+template <class S, class Slot>
+EDGEFEM_LOOP void tet_form_strain_batches_prefetched(const TetEdgeForm<S>& f, index_t b0, index_t b1,
+                                                     const S* __restrict zeta, double* __restrict g, Slot slot) {
     for (index_t b = b0; b < b1; ++b) {
-        if constexpr (Prefetch) prefetch_form_batch(f, b + kFormPrefetchBatches);
+        prefetch_form_batch(f, b + kFormPrefetchBatches);
         tet_form_strain_impl<false>(f, b, zeta, g, nullptr, 0, slot);
     }
 }
-template <bool Prefetch, class S>
-EDGEFEM_LOOP void tet_form_strain_batches(const TetEdgeForm<S>& f, index_t b0, index_t b1, const S* __restrict zeta,
-                                          const ForwardOut<double>& out) {
+template <class S>
+EDGEFEM_LOOP void tet_form_strain_batches_prefetched(const TetEdgeForm<S>& f, index_t b0, index_t b1,
+                                                     const S* __restrict zeta, const ForwardOut<double>& out) {
     for (index_t b = b0; b < b1; ++b) {
-        if constexpr (Prefetch) prefetch_form_batch(f, b + kFormPrefetchBatches);
+        prefetch_form_batch(f, b + kFormPrefetchBatches);
         tet_form_strain_impl<true>(f, b, zeta, out.direct, out.spill, out.end);
     }
-}
-template <class S>
-inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g,
-                            RingSlot slot) {
-    tet_form_strain_impl<false>(f, b, zeta, g, nullptr, 0, slot);
 }
 template <class S>
 inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, const ForwardOut<double>& out) {
@@ -404,7 +399,7 @@ inline void tet_form_stiffness(const TetEdgeForm<S>& f, index_t b, const S* __re
     tet_form_stiffness_impl<true>(f, b, p, out.direct, out.spill, out.end);
 }
 // The stiffness pair terms of batches [b0, b1) with the rows and ids fetched
-// ahead (tet_form_strain_batches), into K or through `out`.
+// ahead (as tet_form_strain_batches_prefetched), into K or through `out`.
 template <class S>
 EDGEFEM_LOOP void tet_form_stiffness_batches_prefetched(const TetEdgeForm<S>& f, index_t b0, index_t b1,
                                                         const S* __restrict p, S* __restrict K) {
@@ -456,12 +451,14 @@ double tet_form_forces_on(const EdgeModel<S>& m, const TetEdgeForm<S>& form, con
         kernel::edge_strain_range(m, u, prev.edge_end, t.edge_end, p, zeta, g, slot);
         if constexpr (Kind == ModelKind::FE) {
             if (tiled)
-                kernel::tet_form_strain_batches<true>(form, prev.batch_end, t.batch_end, zeta, g, slot);
+                kernel::tet_form_strain_batches_prefetched(form, prev.batch_end, t.batch_end, zeta, g, slot);
             else
                 for (index_t b = prev.batch_end; b < t.batch_end; ++b)
                     kernel::tet_form_strain_impl<false>(form, b, zeta, g, nullptr, 0, slot);
         }
         std::fill(f + 3 * std::size_t(prev.zero_end), f + 3 * std::size_t(t.zero_end), S(0));
+        // (The plain call for the stored state: through `out` and the slot
+        // it measured 1-4 % slower on armadillo-7k.)
         if constexpr (std::is_same_v<Slot, EdgeSlot>)
             for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f);
         else

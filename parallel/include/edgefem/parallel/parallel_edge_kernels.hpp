@@ -589,8 +589,8 @@ void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& s
                 // Rows and ids fetched ahead non-temporally on a mesh larger
                 // than the cache (kernel::prefetch_form_batch).
                 if (far) {
-                    kernel::tet_form_strain_batches<true>(form_, prev.batch_end, split, zeta, g, EdgeSlot{});
-                    kernel::tet_form_strain_batches<true>(form_, split, t.batch_end, zeta, gout);
+                    kernel::tet_form_strain_batches_prefetched(form_, prev.batch_end, split, zeta, g, EdgeSlot{});
+                    kernel::tet_form_strain_batches_prefetched(form_, split, t.batch_end, zeta, gout);
                 } else {
                     for (index_t b = prev.batch_end; b < split; ++b) kernel::tet_form_strain(form_, b, zeta, g);
                     for (index_t b = split; b < t.batch_end; ++b) kernel::tet_form_strain(form_, b, zeta, gout);
