@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "edgefem/core/inverted_tets.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
@@ -100,4 +101,14 @@ TEST(ParallelSimulator, InvertedTetCount) {
     }
     EXPECT_GT(serial, 0u);
     EXPECT_EQ(count_inverted_tets_parallel(*ex, s.mesh, u.data()), index_t(serial));
+    // Core's count (deformed positions first) and the parallel one with a
+    // reused scratch, at other thread counts and in float.
+    EXPECT_EQ(count_inverted_tets(s.mesh, u.data()), index_t(serial));
+    std::vector<double> scratch;
+    const std::vector<float> uf(u.begin(), u.end());
+    for (int threads : {1, 2, 4}) {
+        const auto omp = make_executor(Backend::OpenMP, threads);
+        EXPECT_EQ(count_inverted_tets_parallel(*omp, s.mesh, u.data(), scratch), index_t(serial));
+        EXPECT_EQ(count_inverted_tets_parallel(*omp, s.mesh, uf.data(), scratch), count_inverted_tets(s.mesh, uf.data()));
+    }
 }

@@ -78,7 +78,7 @@ public:
         diagonal_blocks(D.data());
         for (index_t v = 0; v < model_.num_vertices; ++v) visit(ctx, v, v, &D[9 * std::size_t(v)]);
     }
-    index_t inverted_tets(const S* u) const override { return count_inverted_tets(mesh_, u); }
+    index_t inverted_tets(const S* u) const override { return count_inverted_tets(mesh_, u, positions_); }
     bool forces_from_tet_local_form() const override { return form_.num_tets > 0; }
     bool forces_stored_state() const override { return !last_on_ring_; }
 
@@ -99,6 +99,7 @@ private:
     FormRing<S> ring_;  // empty unless the form runs in tiles (make_form_ring)
     bool keep_state_ = true, state_stale_ = false, last_on_ring_ = false;
     std::vector<S> u_last_;  // u of the last forces() call on the ring
+    mutable std::vector<double> positions_;  // inverted_tets' scratch
     EdgeStiffness<S> K_;
     std::vector<S> scratch_;
 };
@@ -142,13 +143,14 @@ public:
                     visit(ctx, model_.tet[t][b], model_.tet[t][a], T);
                 }
     }
-    index_t inverted_tets(const S* u) const override { return count_inverted_tets(mesh_, u); }
+    index_t inverted_tets(const S* u) const override { return count_inverted_tets(mesh_, u, positions_); }
 
 private:
     const Mesh& mesh_;
     TetModel<S> model_;
     TetStiffness<S> K_;
     std::vector<S> u_, scratch_;
+    mutable std::vector<double> positions_;  // inverted_tets' scratch
 };
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/inverted_tets.hpp"
 #include "edgefem/core/tet_model.hpp"
 #include "edgefem/parallel/parallel_edge_kernels.hpp"
 #include "edgefem/parallel/parallel_tet_kernels.hpp"
@@ -31,16 +32,26 @@ const char* to_string(Variant v) {
 }
 
 template <class S>
-index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const S* u) {
-    const double n = blocked_sum(ex, std::size_t(mesh.num_tets()), [&](std::size_t t) {
-        double x[4][3];
-        for (int k = 0; k < 4; ++k) {
-            const index_t v = mesh.tets[4 * t + k];
-            for (int r = 0; r < 3; ++r) x[k][r] = mesh.X[3 * std::size_t(v) + r] + double(u[3 * std::size_t(v) + r]);
-        }
-        return signed_volume(x[0], x[1], x[2], x[3]) <= 0 ? 1.0 : 0.0;
+index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const S* u, std::vector<double>& x) {
+    x.resize(mesh.X.size());
+    double* xs = x.data();
+    for_blocks(ex, std::size_t(mesh.num_vertices()), [&](std::size_t b, std::size_t e) {
+        deformed_positions(mesh, u, xs, index_t(b), index_t(e));
     });
-    return index_t(n);
+    const std::size_t nt = std::size_t(mesh.num_tets());
+    const std::size_t chunks = (nt + kVectorChunk - 1) / kVectorChunk;
+    std::vector<index_t> partial(chunks, 0);
+    for_blocks(ex, nt, [&](std::size_t b, std::size_t e) {
+        partial[b / kVectorChunk] = count_inverted_in(mesh, xs, index_t(b), index_t(e));
+    });
+    index_t n = 0;
+    for (index_t c : partial) n += c;
+    return n;
+}
+template <class S>
+index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const S* u) {
+    std::vector<double> x;
+    return count_inverted_tets_parallel(ex, mesh, u, x);
 }
 
 namespace {
@@ -83,7 +94,7 @@ public:
         for (index_t v = 0; v < m.num_vertices; ++v) visit(ctx, v, v, &D[9 * std::size_t(v)]);
     }
     index_t inverted_tets(const S* u) const override {
-        return count_inverted_tets_parallel(k_.executor(), mesh_, u);
+        return count_inverted_tets_parallel(k_.executor(), mesh_, u, positions_);
     }
     bool forces_from_tet_local_form() const override { return Kind == ModelKind::FE && k_.form_forces(); }
 
@@ -103,6 +114,7 @@ private:
     EdgeState<S> state_;
     EdgeStiffness<S> K_;
     std::vector<S> scratch_;
+    mutable std::vector<double> positions_;  // inverted_tets' scratch
 };
 
 template <class S>
@@ -141,13 +153,14 @@ public:
                     visit(ctx, m.tet[t][b], m.tet[t][a], T);
                 }
     }
-    index_t inverted_tets(const S* u) const override { return count_inverted_tets_parallel(*ex_, mesh_, u); }
+    index_t inverted_tets(const S* u) const override { return count_inverted_tets_parallel(*ex_, mesh_, u, positions_); }
 
 private:
     const Mesh& mesh_;
     std::shared_ptr<const Executor> ex_;
     ParallelTetKernels<S> k_;
     TetStiffness<S> K_;
+    mutable std::vector<double> positions_;  // inverted_tets' scratch
     std::vector<S> u_, scratch_;
 };
 
@@ -190,6 +203,9 @@ ColouringReport colouring_report(const Mesh& mesh, const PlanOptions& opts) {
 
 template index_t count_inverted_tets_parallel<double>(const Executor&, const Mesh&, const double*);
 template index_t count_inverted_tets_parallel<float>(const Executor&, const Mesh&, const float*);
+template index_t count_inverted_tets_parallel<double>(const Executor&, const Mesh&, const double*,
+                                                      std::vector<double>&);
+template index_t count_inverted_tets_parallel<float>(const Executor&, const Mesh&, const float*, std::vector<double>&);
 template OperatorFactory<double> parallel_operator_factory<double>(std::shared_ptr<const Executor>, Variant, PlanOptions);
 template OperatorFactory<float> parallel_operator_factory<float>(std::shared_ptr<const Executor>, Variant, PlanOptions);
 template std::unique_ptr<ElasticOperator<double>> make_parallel_operator<double>(const Mesh&, const Materials&, ModelKind,

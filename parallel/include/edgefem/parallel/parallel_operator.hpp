@@ -10,6 +10,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/executor.hpp"
@@ -31,7 +32,10 @@ std::unique_ptr<ElasticOperator<S>> make_parallel_operator(const Mesh& mesh, con
                                                            const PlanOptions& opts = {});
 
 // Tets with non-positive deformed volume, counted on the executor (blocked,
-// so the count is exact for any thread count).
+// so the count is exact for any thread count); the deformed positions go to
+// `x` first (as count_inverted_tets).
+template <class S>
+index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const S* u, std::vector<double>& x);
 template <class S>
 index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const S* u);
 
