@@ -1,17 +1,23 @@
 // The core's ElasticOperator contract (elastic_operator.hpp): build_stiffness
 // builds K at the last forces() call's u, whatever came between (energy(),
 // or a force call that kept no state: keep_state(false) runs the force on a
-// ring, FormRing), and the forces do not depend on keep_state.
+// ring, FormRing), and the forces do not depend on keep_state; an explicit
+// Simulator runs its forces on the ring and steps bitwise as with the state.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/make_box.hpp"
+#include "edgefem/core/simulator.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
+#include "cantilever.hpp"
+#include "forwarding_operator.hpp"
 
 using namespace edgefem;
 
@@ -80,4 +86,56 @@ TEST(ElasticOperator, StiffnessFollowsTheLastForcesOnTiles) {
 
 TEST(ElasticOperator, StiffnessFollowsTheLastForcesInOneTile) {
     check_contract(make_box(5, 4, 3), /*expect_ring=*/false);
+}
+
+namespace {
+
+// Forwards everything; keep_state only when `forward`.
+class KeepStateSpy final : public test::ForwardingOperator {
+public:
+    KeepStateSpy(std::unique_ptr<ElasticOperator<double>> op, bool forward)
+        : ForwardingOperator(std::move(op)), forward_(forward) {}
+    void keep_state(bool keep) override {
+        if (forward_) op_->keep_state(keep);
+    }
+    bool forces_stored_state() const override { return op_->forces_stored_state(); }
+
+private:
+    bool forward_;
+};
+
+}  // namespace
+
+TEST(ElasticOperator, ExplicitStepsOnTheRingMatchStepsWithTheState) {
+    Scene scene = test::clamped_box_scene(30, 12, 12, 1e5);
+    scene.mesh = tiled_box();
+    scene.fixed.clear();  // clamped at x = min again, in the RCM numbering
+    double xmin = std::numeric_limits<double>::infinity();
+    for (index_t v = 0; v < scene.mesh.num_vertices(); ++v) xmin = std::min(xmin, scene.mesh.X[3 * v]);
+    for (index_t v = 0; v < scene.mesh.num_vertices(); ++v)
+        if (scene.mesh.X[3 * v] < xmin + 1e-9) scene.fixed.push_back(v);
+    ASSERT_FALSE(scene.fixed.empty());
+    scene.integrator = Integrator::Explicit;
+    scene.dt = 2e-6;
+    const KeepStateSpy* spy[2] = {nullptr, nullptr};
+    auto factory = [&spy](int i) -> OperatorFactory<double> {
+        return [&spy, i](const Mesh& m, const Materials& mat, ModelKind k, Method me) {
+            auto op = std::make_unique<KeepStateSpy>(make_elastic_operator<double>(m, mat, k, me), i == 0);
+            spy[i] = op.get();
+            return std::unique_ptr<ElasticOperator<double>>(std::move(op));
+        };
+    };
+    Simulator<double> ring(scene, nullptr, factory(0)), kept(scene, nullptr, factory(1));
+    for (int k = 0; k < 5; ++k) {
+        ring.step();
+        kept.step();
+    }
+    ASSERT_TRUE(spy[0] && spy[1]);
+    EXPECT_FALSE(spy[0]->forces_stored_state());  // the explicit scene said keep_state(false)
+    EXPECT_TRUE(spy[1]->forces_stored_state());
+    const auto a = ring.displacement(), b = kept.displacement();
+    EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin()));
+    double moved = 0;
+    for (double x : a) moved = std::max(moved, std::abs(x));
+    EXPECT_GT(moved, 0.0);
 }
