@@ -263,6 +263,10 @@ template <class S>
 inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, double* __restrict g) {
     tet_form_strain_impl<false>(f, b, zeta, g, nullptr, 0);
 }
+template <class S>
+inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, const ForwardOut<double>& out) {
+    tet_form_strain_impl<true>(f, b, zeta, out.direct, out.spill, out.end);
+}
 // The g pass over batches [b0, b1), each batch's rows and ids fetched
 // kFormPrefetchBatches ahead; out of line (EDGEFEM_LOOP says why).
 template <class S, class Slot>
@@ -278,12 +282,8 @@ EDGEFEM_LOOP void tet_form_strain_batches_prefetched(const TetEdgeForm<S>& f, in
                                                      const S* __restrict zeta, const ForwardOut<double>& out) {
     for (index_t b = b0; b < b1; ++b) {
         prefetch_form_batch(f, b + kFormPrefetchBatches);
-        tet_form_strain_impl<true>(f, b, zeta, out.direct, out.spill, out.end);
+        tet_form_strain(f, b, zeta, out);
     }
-}
-template <class S>
-inline void tet_form_strain(const TetEdgeForm<S>& f, index_t b, const S* __restrict zeta, const ForwardOut<double>& out) {
-    tet_form_strain_impl<true>(f, b, zeta, out.direct, out.spill, out.end);
 }
 
 // blk[l][x] += kv[x][l] for the L lanes and 9 values of a block. In float,
@@ -405,7 +405,7 @@ EDGEFEM_LOOP void tet_form_stiffness_batches_prefetched(const TetEdgeForm<S>& f,
                                                         const S* __restrict p, S* __restrict K) {
     for (index_t b = b0; b < b1; ++b) {
         prefetch_form_batch(f, b + kFormPrefetchBatches);
-        tet_form_stiffness_impl<false>(f, b, p, K, static_cast<S*>(nullptr), 0);
+        tet_form_stiffness(f, b, p, K);
     }
 }
 template <class S>
@@ -413,7 +413,7 @@ EDGEFEM_LOOP void tet_form_stiffness_batches_prefetched(const TetEdgeForm<S>& f,
                                                         const S* __restrict p, const ForwardOut<S>& out) {
     for (index_t b = b0; b < b1; ++b) {
         prefetch_form_batch(f, b + kFormPrefetchBatches);
-        tet_form_stiffness_impl<true>(f, b, p, out.direct, out.spill, out.end);
+        tet_form_stiffness(f, b, p, out);
     }
 }
 
