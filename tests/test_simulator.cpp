@@ -166,7 +166,9 @@ TEST(Simulator, DefiniteTangentKeepsCgConvergentOnCompressedCube) {
         const std::size_t n = u.size();
         return conjugate_gradient(
             SerialExecutor{}, n, free_dof.data(), [&](const double* in, double* out) { plain->multiply(in, out); },
-            [n](const double* r, double* z) { std::copy(r, r + n, z); }, b.data(), x.data(), 1e-8, 5000, 0, w);
+            [](std::size_t, std::size_t, const double*, double*) {},
+            [](std::size_t lo, std::size_t hi, const double* r, double* z) { std::copy(r + lo, r + hi, z + lo); },
+            b.data(), x.data(), 1e-8, 5000, 0, w);
     };
     const CgResult p = run_id(false), d = run_id(true);
     EXPECT_TRUE(p.negative_curvature);

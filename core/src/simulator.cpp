@@ -61,11 +61,11 @@ bool spd_inverse3(const double (&B)[3][3], double* inv) {
 // thread count.
 template <class Term>
 std::array<double, 3> blocked_sum3(const Executor& ex, std::size_t n, Term&& term) {
-    std::vector<std::array<double, 3>> partial((n + kVectorChunk - 1) / kVectorChunk, {0.0, 0.0, 0.0});
+    std::vector<std::array<double, 3>> partial((n + kVectorBlock - 1) / kVectorBlock, {0.0, 0.0, 0.0});
     for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) {
         double acc[3] = {0, 0, 0};
         for (std::size_t i = lo; i < hi; ++i) term(i, acc);
-        partial[lo / kVectorChunk] = {acc[0], acc[1], acc[2]};
+        partial[lo / kVectorBlock] = {acc[0], acc[1], acc[2]};
     });
     std::array<double, 3> s{0.0, 0.0, 0.0};
     for (const auto& p : partial)
@@ -244,19 +244,29 @@ struct Simulator<S>::Impl {
         }
     }
 
-    // A = c_m M + c_k K + c_b K0.
-    void apply_system(double c_m, double c_k, double c_b, const double* in, double* out) {
+    // A = c_m M + c_k K + c_b K0, in two parts (as conjugate_gradient takes
+    // it): the products K x (and K0 x into Ax), then per block the diagonal
+    // mass term and the sum.
+    void apply_products(double c_b, const double* in, double* out) {
         multiply(*op, in, out);
-        // Mass per dof, scalars by value: vectorises (over mass[i / 3] with
-        // c_m, c_k by reference it did not).
+        if (c_b != 0) multiply(*op_damp, in, Ax.data());
+    }
+    // Mass per dof, scalars by value: vectorises (over mass[i / 3] with
+    // c_m, c_k by reference it did not).
+    void finish_system(double c_m, double c_k, double c_b, std::size_t lo, std::size_t hi, const double* in,
+                       double* out) const {
         const double* __restrict m = mass_dof.data();
         const double* __restrict xin = in;
         double* __restrict y = out;
-        each([=](std::size_t i) { y[i] = c_m * m[i] * xin[i] + c_k * y[i]; });
+        for (std::size_t i = lo; i < hi; ++i) y[i] = c_m * m[i] * xin[i] + c_k * y[i];
         if (c_b != 0) {
-            multiply(*op_damp, in, Ax.data());
-            each([&](std::size_t i) { out[i] += c_b * Ax[i]; });
+            const double* __restrict a = Ax.data();
+            for (std::size_t i = lo; i < hi; ++i) y[i] += c_b * a[i];
         }
+    }
+    void apply_system(double c_m, double c_k, double c_b, const double* in, double* out) {
+        apply_products(c_b, in, out);
+        for_blocks(*exec, n(), [&](std::size_t lo, std::size_t hi) { finish_system(c_m, c_k, c_b, lo, hi, in, out); });
     }
 
     // Block-Jacobi: inverse of each vertex's 3x3 diagonal block of A; a
@@ -364,8 +374,11 @@ struct Simulator<S>::Impl {
             x[i] /= s;
         });
         res = conjugate_gradient(
-            *exec, n(), free_dof.data(), [&](const double* in, double* out) { apply_system(c_m, c_k, c_b, in, out); },
-            [&](const double* r_in, double* z_out) {
+            *exec, n(), free_dof.data(), [&](const double* in, double* out) { apply_products(c_b, in, out); },
+            [&](std::size_t lo, std::size_t hi, const double* in, double* out) {
+                finish_system(c_m, c_k, c_b, lo, hi, in, out);
+            },
+            [&](std::size_t lo, std::size_t hi, const double* r_in, double* z_out) {
                 const double* __restrict r = r_in;
                 double* __restrict z = z_out;
                 const double* __restrict Minv = Dinv.data();
@@ -374,7 +387,7 @@ struct Simulator<S>::Impl {
                 // rows are its columns; lane 3 reads the next value (Dinv
                 // has one spare at the end) and is never stored.
                 typedef double V4 __attribute__((vector_size(32)));
-                each_vertex([=](std::size_t vtx) {
+                for (std::size_t vtx = lo / 3; vtx < hi / 3; ++vtx) {
                     const double* M = &Minv[9 * vtx];
                     const double* rv = &r[3 * vtx];
                     V4 m0, m1, m2;
@@ -383,7 +396,7 @@ struct Simulator<S>::Impl {
                     __builtin_memcpy(&m2, M + 6, sizeof m2);
                     const V4 zv = rv[0] * m0 + rv[1] * m1 + rv[2] * m2;
                     for (int i = 0; i < 3; ++i) z[3 * vtx + i] = zv[i];
-                });
+                }
             },
             b.data(), x.data(), tolerance, scene.solver.cg_max_iterations, scene.solver.cg_fixed_iterations, cg);
         if (s != 1) each([&](std::size_t i) {
@@ -509,12 +522,12 @@ struct Simulator<S>::Impl {
 
     void check_finite(long step_no) const {
         // First non-finite dof, found block-parallel.
-        const std::size_t chunks = (n() + kVectorChunk - 1) / kVectorChunk;
+        const std::size_t chunks = (n() + kVectorBlock - 1) / kVectorBlock;
         std::vector<std::size_t> first(chunks, n());
         for_blocks(*exec, n(), [&](std::size_t lo, std::size_t hi) {
             for (std::size_t i = lo; i < hi; ++i)
                 if (!std::isfinite(double(u[i])) || !std::isfinite(double(v[i]))) {
-                    first[lo / kVectorChunk] = i;
+                    first[lo / kVectorBlock] = i;
                     break;
                 }
         });

@@ -55,14 +55,26 @@ OmpExecutor::OmpExecutor(int threads, Schedule schedule)
 // region; on a 16-core VM that made an 8-thread force call on armadillo-7k
 // 7x slower than at 4 threads. Idle members just pass the barrier.
 
-void OmpExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const {
+void OmpExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const { chunks(schedule_, n, body); }
+void OmpExecutor::for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const {
+    chunks(Schedule::Static, n, body);
+}
+void OmpExecutor::for_phases(int n, const index_t* chunk_first, const std::function<void(int, index_t)>& body) const {
+    phases(schedule_, n, chunk_first, body);
+}
+void OmpExecutor::for_uniform_phases(int n, const index_t* chunk_first,
+                                     const std::function<void(int, index_t)>& body) const {
+    phases(Schedule::Static, n, chunk_first, body);
+}
+
+void OmpExecutor::chunks(Schedule schedule, index_t n, const std::function<void(index_t)>& body) const {
     if (n <= 0) return;
     if (n == 1 || threads_ == 1) {  // no parallel region for nothing to share
         for (index_t c = 0; c < n; ++c) body(c);
         return;
     }
     const int t = threads_;
-    if (schedule_ == Schedule::Static) {
+    if (schedule == Schedule::Static) {
 #pragma omp parallel for num_threads(t) schedule(static)
         for (index_t c = 0; c < n; ++c) body(c);
     } else {
@@ -71,8 +83,8 @@ void OmpExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body
     }
 }
 
-void OmpExecutor::for_phases(int phases, const index_t* chunk_first,
-                             const std::function<void(int, index_t)>& body) const {
+void OmpExecutor::phases(Schedule schedule, int phases, const index_t* chunk_first,
+                         const std::function<void(int, index_t)>& body) const {
     index_t widest = 0;
     for (int p = 0; p < phases; ++p) widest = std::max(widest, chunk_first[p + 1] - chunk_first[p]);
     if (threads_ == 1 || widest <= 1) {
@@ -81,7 +93,7 @@ void OmpExecutor::for_phases(int phases, const index_t* chunk_first,
         return;
     }
     const int t = threads_;
-    if (schedule_ == Schedule::Static) {
+    if (schedule == Schedule::Static) {
 #pragma omp parallel num_threads(t)
         for (int p = 0; p < phases; ++p) {
 #pragma omp for schedule(static)
@@ -115,7 +127,19 @@ TbbExecutor::TbbExecutor(int threads, Schedule schedule)
 
 TbbExecutor::~TbbExecutor() = default;
 
-void TbbExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const {
+void TbbExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const { chunks(schedule_, n, body); }
+void TbbExecutor::for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const {
+    chunks(Schedule::Static, n, body);
+}
+void TbbExecutor::for_phases(int n, const index_t* chunk_first, const std::function<void(int, index_t)>& body) const {
+    phases(schedule_, n, chunk_first, body);
+}
+void TbbExecutor::for_uniform_phases(int n, const index_t* chunk_first,
+                                     const std::function<void(int, index_t)>& body) const {
+    phases(Schedule::Static, n, chunk_first, body);
+}
+
+void TbbExecutor::chunks(Schedule schedule, index_t n, const std::function<void(index_t)>& body) const {
     if (n <= 0) return;
     if (n == 1 || threads_ == 1) {
         for (index_t c = 0; c < n; ++c) body(c);
@@ -126,15 +150,15 @@ void TbbExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body
         for (index_t c = r.begin(); c < r.end(); ++c) body(c);
     };
     impl_->arena.execute([&] {
-        if (schedule_ == Schedule::Static)
+        if (schedule == Schedule::Static)
             tbb::parallel_for(range, run, tbb::static_partitioner());
         else
             tbb::parallel_for(range, run, tbb::simple_partitioner());
     });
 }
 
-void TbbExecutor::for_phases(int phases, const index_t* chunk_first,
-                             const std::function<void(int, index_t)>& body) const {
+void TbbExecutor::phases(Schedule schedule, int phases, const index_t* chunk_first,
+                         const std::function<void(int, index_t)>& body) const {
     if (threads_ == 1) {
         for (int p = 0; p < phases; ++p)
             for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
@@ -148,7 +172,7 @@ void TbbExecutor::for_phases(int phases, const index_t* chunk_first,
             };
             if (n <= 1) {
                 if (n == 1) body(p, 0);
-            } else if (schedule_ == Schedule::Static) {
+            } else if (schedule == Schedule::Static) {
                 tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 1), run, tbb::static_partitioner());
             } else {
                 tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 1), run, tbb::simple_partitioner());

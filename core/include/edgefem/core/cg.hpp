@@ -23,87 +23,134 @@ struct CgResult {
 struct CgWork {
     std::vector<double> r, z, p, Ap;  // double: the iteration's recurrences stay accurate for float A
     std::vector<double> keep;         // 1 on unknowns, 0 on constrained dofs
+    std::vector<double> partial;      // per-block partial sums (3 per block)
 };
 
-// n scalars; free_dof[i] != 0 for unknowns. apply_A(const double* x, double* y)
-// overwrites y = A x; apply_M(const double* r, double* z) overwrites
-// z = M^-1 r. `fixed_iterations` > 0 runs exactly that many iterations
-// (unless the residual vanishes), ignoring the tolerance.
-template <class ApplyA, class ApplyM>
+// n scalars; free_dof[i] != 0 for unknowns. The system matrix is applied in
+// two parts: apply_A(const double* x, double* y) overwrites y with the
+// whole-vector part (a stiffness product, free to run its own parallel
+// loops), then finish_A(lo, hi, x, y) completes y on the block [lo, hi)
+// (diagonal terms: mass, scaling; may do nothing). apply_M(lo, hi, r, z)
+// overwrites z = M^-1 r on [lo, hi) from r on [lo, hi) only. Block bounds
+// are multiples of kVectorBlock (a multiple of 3: whole vertices) or n.
+// `fixed_iterations` > 0 runs exactly that many iterations (unless the
+// residual vanishes), ignoring the tolerance.
+//
+// Between two products an iteration is one pass of three phases over the
+// blocks, one parallel region with two barriers: (0) finish A p, partials
+// of p.Ap; (1) alpha, x and r updated, partials of r.r, z = M^-1 r,
+// partials of r.z; (2) beta, p updated. Every block sums the partials in
+// block order itself, so no serial section sits between the phases and the
+// sums are the same for any thread count. (On armadillo-7k a step's CG
+// vector work ran as ~7 whole-vector passes on one thread: its 6558 dofs
+// were one block.)
+template <class ApplyA, class FinishA, class ApplyM>
 CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_t* free_dof, ApplyA&& apply_A,
-                            ApplyM&& apply_M, const double* b, double* x, double tolerance, int max_iterations,
-                            int fixed_iterations, CgWork& w) {
+                            FinishA&& finish_A, ApplyM&& apply_M, const double* b, double* x, double tolerance,
+                            int max_iterations, int fixed_iterations, CgWork& w) {
     w.r.resize(n);
     w.z.resize(n);
     w.p.resize(n);
     w.Ap.resize(n);
     w.keep.resize(n);
-    auto dot = [&](const std::vector<double>& a, const std::vector<double>& c) {
-        return blocked_sum(ex, n, [&](std::size_t i) { return a[i] * c[i]; });
-    };
+    const std::size_t nb = vector_blocks(n);
+    w.partial.assign(4 * nb, 0.0);
     // The projection multiplies by keep (1 or 0) inside the passes: g++ 12
     // vectorises none of these loops with a select on free_dof in them.
     // A p is not projected in a pass of its own (p is zero on constrained
     // dofs: p.Ap takes keep in its terms and r in its update), nor is z (r
     // is zero there: r.z takes keep, and p in its update). Scalars by value
     // and arrays through local restrict pointers, so that the loops
-    // vectorise.
+    // vectorise; within a block the updates and the sums are separate loops
+    // (an update inside block_sum's terms does not vectorise), the block
+    // still in cache for the second.
     double* __restrict r = w.r.data();
     double* __restrict z = w.z.data();
     double* __restrict p = w.p.data();
     double* __restrict Ap = w.Ap.data();
     double* __restrict keep = w.keep.data();
-    for_blocks(ex, n, [=](std::size_t lo, std::size_t hi) {
-        for (std::size_t i = lo; i < hi; ++i) keep[i] = free_dof[i] ? 1.0 : 0.0;
-    });
-    const double bnorm = std::sqrt(blocked_sum(ex, n, [=](std::size_t i) { return b[i] * b[i] * keep[i]; }));
-    const double scale = bnorm > 0 ? bnorm : 1.0;
+    double* __restrict xs = x;
+    double* const pap_part = w.partial.data();
+    double* const rr_part = pap_part + nb;
+    double* const rz_part = rr_part + nb;
+    double* const bb_part = rz_part + nb;
+    const auto total = [nb](const double* part) {
+        double s = 0;
+        for (std::size_t k = 0; k < nb; ++k) s += part[k];
+        return s;
+    };
+    const index_t groups = block_groups(ex, nb);
+    const index_t phase_first[4] = {0, groups, 2 * groups, 3 * groups};
+    // blocks(g, body): body(lo, hi, k) over the blocks k of group g.
+    const auto blocks = [&](index_t g, auto&& body) {
+        for_group_blocks(g, groups, n, [&](std::size_t lo, std::size_t hi) { body(lo, hi, lo / kVectorBlock); });
+    };
 
-    // (Fusing each vector update into the dot product after it, one pass
-    // instead of two, measured 3 % slower per step on armadillo-7k: the
-    // updates no longer vectorise inside blocked_sum's 4-lane sums.)
-    apply_A(x, Ap);
-    for_blocks(ex, n, [=](std::size_t lo, std::size_t hi) {
-        for (std::size_t i = lo; i < hi; ++i) r[i] = (b[i] - Ap[i]) * keep[i];
-    });
     CgResult res;
-    res.residual = std::sqrt(dot(w.r, w.r)) / scale;
+    apply_A(x, Ap);
+    ex.for_uniform_phases(1, phase_first, [&](int, index_t g) {
+        blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
+            for (std::size_t i = lo; i < hi; ++i) keep[i] = free_dof[i] ? 1.0 : 0.0;
+            finish_A(lo, hi, x, Ap);
+            for (std::size_t i = lo; i < hi; ++i) r[i] = (b[i] - Ap[i]) * keep[i];
+            bb_part[k] = block_sum(lo, hi, [=](std::size_t i) { return b[i] * b[i] * keep[i]; });
+            rr_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * r[i]; });
+            apply_M(lo, hi, r, z);
+            for (std::size_t i = lo; i < hi; ++i) p[i] = z[i] * keep[i];
+            rz_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * p[i]; });
+        });
+    });
+    const double bnorm = std::sqrt(total(bb_part));
+    const double scale = bnorm > 0 ? bnorm : 1.0;
+    res.residual = std::sqrt(total(rr_part)) / scale;
     const int limit = fixed_iterations > 0 ? fixed_iterations : max_iterations;
     if (fixed_iterations == 0 && res.residual <= tolerance) {
         res.converged = true;
         return res;
     }
-    apply_M(r, z);
-    for_blocks(ex, n, [=](std::size_t lo, std::size_t hi) {
-        for (std::size_t i = lo; i < hi; ++i) p[i] = z[i] * keep[i];
-    });
-    double rz = dot(w.r, w.p);
+    double rz = total(rz_part);
+    const auto converged = [&](double residual) { return fixed_iterations == 0 && residual <= tolerance; };
     for (int it = 0; it < limit; ++it) {
         if (res.residual == 0) break;
         apply_A(p, Ap);
-        const double pAp = blocked_sum(ex, n, [=](std::size_t i) { return p[i] * Ap[i] * keep[i]; });
-        if (!(pAp > 0)) {  // also catches NaN
+        // Each group sums the partials it needs once, in block order.
+        ex.for_uniform_phases(3, phase_first, [&, rz](int phase, index_t g) {
+            if (phase == 0) {
+                blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
+                    finish_A(lo, hi, p, Ap);
+                    pap_part[k] = block_sum(lo, hi, [=](std::size_t i) { return p[i] * Ap[i] * keep[i]; });
+                });
+                return;
+            }
+            const double pAp = total(pap_part);
+            if (!(pAp > 0)) return;  // negative curvature (or NaN): x stays at the last good iterate
+            if (phase == 1) {
+                const double alpha = rz / pAp;
+                blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
+                    for (std::size_t i = lo; i < hi; ++i) {
+                        xs[i] += alpha * p[i];
+                        r[i] = (r[i] - alpha * Ap[i]) * keep[i];
+                    }
+                    rr_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * r[i]; });
+                    apply_M(lo, hi, r, z);
+                    rz_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * z[i] * keep[i]; });
+                });
+                return;
+            }
+            if (converged(std::sqrt(total(rr_part)) / scale)) return;
+            const double beta = total(rz_part) / rz;
+            blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t) {
+                for (std::size_t i = lo; i < hi; ++i) p[i] = (z[i] + beta * p[i]) * keep[i];
+            });
+        });
+        if (!(total(pap_part) > 0)) {  // also catches NaN
             res.negative_curvature = true;
             break;
         }
-        const double alpha = rz / pAp;
-        double* __restrict xs = x;
-        for_blocks(ex, n, [=](std::size_t lo, std::size_t hi) {
-            for (std::size_t i = lo; i < hi; ++i) {
-                xs[i] += alpha * p[i];
-                r[i] = (r[i] - alpha * Ap[i]) * keep[i];
-            }
-        });
         ++res.iterations;
-        res.residual = std::sqrt(dot(w.r, w.r)) / scale;
-        if (fixed_iterations == 0 && res.residual <= tolerance) break;
-        apply_M(r, z);
-        const double rz_new = blocked_sum(ex, n, [=](std::size_t i) { return r[i] * z[i] * keep[i]; });
-        const double beta = rz_new / rz;
-        rz = rz_new;
-        for_blocks(ex, n, [=](std::size_t lo, std::size_t hi) {
-            for (std::size_t i = lo; i < hi; ++i) p[i] = (z[i] + beta * p[i]) * keep[i];
-        });
+        res.residual = std::sqrt(total(rr_part)) / scale;
+        if (converged(res.residual)) break;
+        rz = total(rz_part);
     }
     res.converged = !res.negative_curvature && res.residual <= tolerance;
     return res;

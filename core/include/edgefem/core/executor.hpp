@@ -33,6 +33,17 @@ public:
         for (int p = 0; p < phases; ++p)
             for_chunks(chunk_first[p + 1] - chunk_first[p], [&](index_t c) { body(p, c); });
     }
+    // The same for chunks of equal work (the fixed blocks of the vector
+    // operations): an executor may hand them out statically, the same
+    // chunks to the same threads at every call, so that each thread's share
+    // of the vectors stays in its own cache from one CG pass to the next.
+    virtual void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const {
+        for_chunks(n, body);
+    }
+    virtual void for_uniform_phases(int phases, const index_t* chunk_first,
+                                    const std::function<void(int, index_t)>& body) const {
+        for_phases(phases, chunk_first, body);
+    }
 };
 
 class SerialExecutor final : public Executor {
@@ -44,44 +55,68 @@ public:
     }
 };
 
-// Elements per chunk of the blocked vector operations (fixed: results do not
-// depend on the thread count).
-inline constexpr std::size_t kVectorChunk = 8192;
+// Elements per block of the blocked vector operations. Fixed, so blocked
+// sums are the same for any thread count; a multiple of 3 (a block of dofs
+// holds whole vertices) and of 8 (the 8-lane sums). Small, so that a
+// cache-resident mesh's vectors split evenly over the threads: with 8192 a
+// step's CG vector work on armadillo-7k (6558 dofs) ran on one thread, and
+// with 1536 bunny-4k's 3 blocks split 2:1. The blocks are handed out in
+// groups (block_groups), so a large mesh does not pay one scheduling step
+// per block.
+inline constexpr std::size_t kVectorBlock = 384;
 
-// body(begin, end) over [0, n) in kVectorChunk blocks.
-template <class Body>
-void for_blocks(const Executor& ex, std::size_t n, Body&& body) {
-    const index_t chunks = static_cast<index_t>((n + kVectorChunk - 1) / kVectorChunk);
-    ex.for_chunks(chunks, [&](index_t c) {
-        const std::size_t b = std::size_t(c) * kVectorChunk;
-        body(b, std::min(n, b + kVectorChunk));
-    });
+inline std::size_t vector_blocks(std::size_t n) { return (n + kVectorBlock - 1) / kVectorBlock; }
+
+// Groups of consecutive blocks, a few per thread (dynamic schedules
+// balance them). The grouping depends on the thread count; the blocks, and
+// so the results, do not.
+inline index_t block_groups(const Executor& ex, std::size_t blocks) {
+    return static_cast<index_t>(std::min<std::size_t>(blocks, 4 * std::size_t(std::max(1, ex.threads()))));
 }
 
-// Sum over [0, n) of term(i): per-block partial sums, added in block order.
-// Inside a block, 8 interleaved accumulators combined pairwise: a single
-// running sum waits one add latency per term (a CG dot product over
-// armadillo-7k took 12% of a semi-implicit step), 8 of them vectorise. The
-// order depends on n only, so the sum is the same for any thread count.
+// body(begin, end) for every block of group g of `groups` over [0, n).
+template <class Body>
+void for_group_blocks(index_t g, index_t groups, std::size_t n, Body&& body) {
+    const std::size_t nb = vector_blocks(n);
+    const std::size_t k0 = nb * std::size_t(g) / std::size_t(groups), k1 = nb * std::size_t(g + 1) / std::size_t(groups);
+    for (std::size_t k = k0; k < k1; ++k) body(k * kVectorBlock, std::min(n, (k + 1) * kVectorBlock));
+}
+
+// body(begin, end) over [0, n) in kVectorBlock blocks.
+template <class Body>
+void for_blocks(const Executor& ex, std::size_t n, Body&& body) {
+    const index_t groups = block_groups(ex, vector_blocks(n));
+    ex.for_uniform_chunks(groups, [&](index_t g) { for_group_blocks(g, groups, n, body); });
+}
+
+// Sum of term(i) over one block [b, e): 8 interleaved accumulators combined
+// pairwise. A single running sum waits one add latency per term (a CG dot
+// product over armadillo-7k took 12% of a semi-implicit step), 8 of them
+// vectorise. The order depends on b and e only.
+template <class Term>
+double block_sum(std::size_t b, std::size_t e, Term&& term) {
+    // Vector types spelled out: with a plain a[8] g++ 12 vectorises the
+    // outer loop instead and shuffles every term.
+    typedef double V4 __attribute__((vector_size(32)));
+    V4 s0 = {0, 0, 0, 0}, s1 = {0, 0, 0, 0};
+    std::size_t i = b;
+    for (; i + 8 <= e; i += 8) {
+        s0 += V4{term(i), term(i + 1), term(i + 2), term(i + 3)};
+        s1 += V4{term(i + 4), term(i + 5), term(i + 6), term(i + 7)};
+    }
+    double tail = 0;
+    for (; i < e; ++i) tail += term(i);
+    const V4 s = s0 + s1;
+    return ((s[0] + s[1]) + (s[2] + s[3])) + tail;
+}
+
+// Sum over [0, n) of term(i): per-block partial sums (block_sum), added in
+// block order. The order depends on n only, so the sum is the same for any
+// thread count.
 template <class Term>
 double blocked_sum(const Executor& ex, std::size_t n, Term&& term) {
-    const std::size_t chunks = (n + kVectorChunk - 1) / kVectorChunk;
-    std::vector<double> partial(chunks, 0.0);
-    for_blocks(ex, n, [&](std::size_t b, std::size_t e) {
-        // Vector types spelled out: with a plain a[8] g++ 12 vectorises the
-        // outer loop instead and shuffles every term.
-        typedef double V4 __attribute__((vector_size(32)));
-        V4 s0 = {0, 0, 0, 0}, s1 = {0, 0, 0, 0};
-        std::size_t i = b;
-        for (; i + 8 <= e; i += 8) {
-            s0 += V4{term(i), term(i + 1), term(i + 2), term(i + 3)};
-            s1 += V4{term(i + 4), term(i + 5), term(i + 6), term(i + 7)};
-        }
-        double tail = 0;
-        for (; i < e; ++i) tail += term(i);
-        const V4 s = s0 + s1;
-        partial[b / kVectorChunk] = ((s[0] + s[1]) + (s[2] + s[3])) + tail;
-    });
+    std::vector<double> partial(vector_blocks(n), 0.0);
+    for_blocks(ex, n, [&](std::size_t b, std::size_t e) { partial[b / kVectorBlock] = block_sum(b, e, term); });
     double s = 0;
     for (double p : partial) s += p;
     return s;

@@ -37,8 +37,15 @@ public:
     // One parallel region for all phases, `omp for` (with its barrier) per phase.
     void for_phases(int phases, const index_t* chunk_first,
                     const std::function<void(int, index_t)>& body) const override;
+    // Always schedule(static), whatever `schedule`.
+    void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const override;
+    void for_uniform_phases(int phases, const index_t* chunk_first,
+                            const std::function<void(int, index_t)>& body) const override;
 
 private:
+    void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const;
+    void phases(Schedule s, int phases, const index_t* chunk_first,
+                const std::function<void(int, index_t)>& body) const;
     int threads_;
     Schedule schedule_;
 };
@@ -58,8 +65,15 @@ public:
     // All phases inside one arena entry, one parallel_for per phase.
     void for_phases(int phases, const index_t* chunk_first,
                     const std::function<void(int, index_t)>& body) const override;
+    // Always the static partitioner, whatever `schedule`.
+    void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const override;
+    void for_uniform_phases(int phases, const index_t* chunk_first,
+                            const std::function<void(int, index_t)>& body) const override;
 
 private:
+    void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const;
+    void phases(Schedule s, int phases, const index_t* chunk_first,
+                const std::function<void(int, index_t)>& body) const;
     struct Impl;
     int threads_;
     Schedule schedule_;
