@@ -93,7 +93,7 @@ template <int W, class T, class Body>
 void run_forward_spill(const Executor& ex, const ForwardSpill& fs, T* out, std::vector<T>& spill, Body&& body) {
     const index_t P = fs.parts();
     const index_t phase_first[3] = {0, P, 2 * P};
-    ex.for_phases(2, phase_first, [&](int phase, index_t p) {
+    ex.for_uniform_phases(2, phase_first, [&](int phase, index_t p) {
         const index_t begin = fs.part_first[p], end = fs.part_first[p + 1];
         if (phase == 0)
             body(p, begin, end, kernel::ForwardOut<T>{out, spill.data() + W * fs.window_first[p], end});
