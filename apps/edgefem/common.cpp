@@ -118,11 +118,13 @@ void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required
 
 // ---- Execution ------------------------------------------------------------
 
-std::shared_ptr<const Executor> ExecOptions::executor() const { return make_executor(parse_backend(backend), threads); }
+std::shared_ptr<const Executor> ExecOptions::executor() const {
+    return make_executor(parse_backend(backend), threads, parse_schedule(schedule));
+}
 
 std::string ExecOptions::describe() const {
     if (!parallel_kernels()) return "serial";
-    return std::string(backend) + " x" + std::to_string(executor()->threads()) + ", " + variant;
+    return std::string(backend) + " x" + std::to_string(executor()->threads()) + ", " + variant + ", " + schedule;
 }
 
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
@@ -132,6 +134,13 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
         ->capture_default_str();
     cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb back-end (0: all hardware threads)")
         ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    cmd.add_option("--schedule", opts.schedule,
+                   "How the omp/tbb back-end hands the kernels' chunks to threads: dynamic (balances uneven "
+                   "parts) or static (the same chunks to the same threads at every call, so each thread's "
+                   "data stays in its cache). Results are identical; CG's vector passes and the owner K x "
+                   "are always static (docs/parallel.md)")
+        ->check(CLI::IsMember({"static", "dynamic"}))
         ->capture_default_str();
     if (with_variant)
         cmd.add_option("--variant", opts.variant,

@@ -89,6 +89,7 @@ struct ExecOptions {
     int threads = 0;                 // 0: all hardware threads
     std::string variant = "auto";  // auto | colour | gather | atomic | private | owner (docs/parallel.md)
     bool variant_given = false;      // --variant on the command line
+    std::string schedule = "dynamic";  // static | dynamic (how the kernels' chunks go to threads)
 
     // The parallel kernels run unless this is the plain serial default
     // (--backend serial without --variant: core's serial loops).
@@ -98,7 +99,7 @@ struct ExecOptions {
     std::string describe() const;
 };
 
-// Adds --backend, --threads and (with_variant) --variant.
+// Adds --backend, --threads, --schedule and (with_variant) --variant.
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant = true);
 
 // The elastic-model factory a simulator should use under `exec` (empty for
