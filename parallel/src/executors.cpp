@@ -46,7 +46,7 @@ int hardware_threads() {
 // ---- OpenMP ---------------------------------------------------------------
 
 OmpExecutor::OmpExecutor(int threads, Schedule schedule)
-    : threads_(threads > 0 ? threads : omp_get_max_threads()), schedule_(schedule) {}
+    : ScheduledExecutor(threads > 0 ? threads : omp_get_max_threads(), schedule) {}
 
 // Every parallel region has the full team, also when a pass has fewer
 // chunks than threads: libgomp keeps its pool only while consecutive
@@ -54,18 +54,6 @@ OmpExecutor::OmpExecutor(int threads, Schedule schedule)
 // then 8 edge blocks) docks and wakes threads through futexes at every
 // region; on a 16-core VM that made an 8-thread force call on armadillo-7k
 // 7x slower than at 4 threads. Idle members just pass the barrier.
-
-void OmpExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const { chunks(schedule_, n, body); }
-void OmpExecutor::for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const {
-    chunks(Schedule::Static, n, body);
-}
-void OmpExecutor::for_phases(int n, const index_t* chunk_first, const std::function<void(int, index_t)>& body) const {
-    phases(schedule_, n, chunk_first, body);
-}
-void OmpExecutor::for_uniform_phases(int n, const index_t* chunk_first,
-                                     const std::function<void(int, index_t)>& body) const {
-    phases(Schedule::Static, n, chunk_first, body);
-}
 
 void OmpExecutor::chunks(Schedule schedule, index_t n, const std::function<void(index_t)>& body) const {
     if (n <= 0) return;
@@ -83,8 +71,8 @@ void OmpExecutor::chunks(Schedule schedule, index_t n, const std::function<void(
     }
 }
 
-void OmpExecutor::phases(Schedule schedule, int phases, const index_t* chunk_first,
-                         const std::function<void(int, index_t)>& body) const {
+void OmpExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk_first,
+                             const std::function<void(int, index_t)>& body) const {
     index_t widest = 0;
     for (int p = 0; p < phases; ++p) widest = std::max(widest, chunk_first[p + 1] - chunk_first[p]);
     if (threads_ == 1 || widest <= 1) {
@@ -121,23 +109,10 @@ struct TbbExecutor::Impl {
 };
 
 TbbExecutor::TbbExecutor(int threads, Schedule schedule)
-    : threads_(threads > 0 ? threads : tbb::info::default_concurrency()),
-      schedule_(schedule),
+    : ScheduledExecutor(threads > 0 ? threads : tbb::info::default_concurrency(), schedule),
       impl_(std::make_unique<Impl>(threads_)) {}
 
 TbbExecutor::~TbbExecutor() = default;
-
-void TbbExecutor::for_chunks(index_t n, const std::function<void(index_t)>& body) const { chunks(schedule_, n, body); }
-void TbbExecutor::for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const {
-    chunks(Schedule::Static, n, body);
-}
-void TbbExecutor::for_phases(int n, const index_t* chunk_first, const std::function<void(int, index_t)>& body) const {
-    phases(schedule_, n, chunk_first, body);
-}
-void TbbExecutor::for_uniform_phases(int n, const index_t* chunk_first,
-                                     const std::function<void(int, index_t)>& body) const {
-    phases(Schedule::Static, n, chunk_first, body);
-}
 
 void TbbExecutor::chunks(Schedule schedule, index_t n, const std::function<void(index_t)>& body) const {
     if (n <= 0) return;
@@ -157,8 +132,8 @@ void TbbExecutor::chunks(Schedule schedule, index_t n, const std::function<void(
     });
 }
 
-void TbbExecutor::phases(Schedule schedule, int phases, const index_t* chunk_first,
-                         const std::function<void(int, index_t)>& body) const {
+void TbbExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk_first,
+                             const std::function<void(int, index_t)>& body) const {
     if (threads_ == 1) {
         for (int p = 0; p < phases; ++p)
             for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);

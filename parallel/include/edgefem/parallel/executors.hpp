@@ -26,31 +26,51 @@ const char* to_string(Backend b);
 Schedule parse_schedule(std::string_view name);  // "static" | "dynamic"
 const char* to_string(Schedule s);
 
-class OmpExecutor final : public Executor {
+// An executor with a schedule: for_chunks / for_phases use it, the uniform
+// variants always hand chunks out statically. Subclasses implement the two
+// loops for a given schedule.
+class ScheduledExecutor : public Executor {
 public:
-    // threads <= 0: omp_get_max_threads().
-    explicit OmpExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
     int threads() const override { return threads_; }
-    const char* name() const override { return "omp"; }
     Schedule schedule() const { return schedule_; }
-    void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
-    // One parallel region for all phases, `omp for` (with its barrier) per phase.
+    void for_chunks(index_t n, const std::function<void(index_t)>& body) const override {
+        chunks(schedule_, n, body);
+    }
     void for_phases(int phases, const index_t* chunk_first,
-                    const std::function<void(int, index_t)>& body) const override;
-    // Always schedule(static), whatever `schedule`.
-    void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const override;
+                    const std::function<void(int, index_t)>& body) const override {
+        run_phases(schedule_, phases, chunk_first, body);
+    }
+    void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const override {
+        chunks(Schedule::Static, n, body);
+    }
     void for_uniform_phases(int phases, const index_t* chunk_first,
-                            const std::function<void(int, index_t)>& body) const override;
+                            const std::function<void(int, index_t)>& body) const override {
+        run_phases(Schedule::Static, phases, chunk_first, body);
+    }
 
-private:
-    void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const;
-    void phases(Schedule s, int phases, const index_t* chunk_first,
-                const std::function<void(int, index_t)>& body) const;
+protected:
+    ScheduledExecutor(int threads, Schedule schedule) : threads_(threads), schedule_(schedule) {}
+    virtual void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const = 0;
+    virtual void run_phases(Schedule s, int phases, const index_t* chunk_first,
+                            const std::function<void(int, index_t)>& body) const = 0;
     int threads_;
     Schedule schedule_;
 };
 
-class TbbExecutor final : public Executor {
+class OmpExecutor final : public ScheduledExecutor {
+public:
+    // threads <= 0: omp_get_max_threads().
+    explicit OmpExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
+    const char* name() const override { return "omp"; }
+
+private:
+    void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const override;
+    // One parallel region for all phases, `omp for` (with its barrier) per phase.
+    void run_phases(Schedule s, int phases, const index_t* chunk_first,
+                    const std::function<void(int, index_t)>& body) const override;
+};
+
+class TbbExecutor final : public ScheduledExecutor {
 public:
     // threads <= 0: the default concurrency. TBB never runs more threads
     // than its global limit (the hardware threads unless the application
@@ -58,25 +78,14 @@ public:
     // splits the work the same way, on fewer threads.
     explicit TbbExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
     ~TbbExecutor() override;
-    int threads() const override { return threads_; }
     const char* name() const override { return "tbb"; }
-    Schedule schedule() const { return schedule_; }
-    void for_chunks(index_t n, const std::function<void(index_t)>& body) const override;
-    // All phases inside one arena entry, one parallel_for per phase.
-    void for_phases(int phases, const index_t* chunk_first,
-                    const std::function<void(int, index_t)>& body) const override;
-    // Always the static partitioner, whatever `schedule`.
-    void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const override;
-    void for_uniform_phases(int phases, const index_t* chunk_first,
-                            const std::function<void(int, index_t)>& body) const override;
 
 private:
-    void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const;
-    void phases(Schedule s, int phases, const index_t* chunk_first,
-                const std::function<void(int, index_t)>& body) const;
+    void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const override;
+    // All phases inside one arena entry, one parallel_for per phase.
+    void run_phases(Schedule s, int phases, const index_t* chunk_first,
+                    const std::function<void(int, index_t)>& body) const override;
     struct Impl;
-    int threads_;
-    Schedule schedule_;
     std::unique_ptr<Impl> impl_;
 };
 
