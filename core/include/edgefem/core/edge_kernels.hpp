@@ -559,8 +559,8 @@ void edge_stiffness_all(const EdgeModel<S>& m, const EdgeState<S>& st, EdgeStiff
 // has run (later segments only write vertices past their own), so it is
 // copied out right there. Bitwise the same as on xyz strides; armadillo-7k,
 // 1 thread: 3.77 -> 3.45 ns per edge, the copies included (the kernel alone
-// on padded vectors: 2.7). The owner variant keeps xyz strides: the copies
-// need a third phase, and its barrier made K x at 2 threads 1.3x slower.
+// on padded vectors: 2.7). The owner variant (parallel/) runs padded copies
+// too, in three phases, its loops out of line (edge_kx_segments).
 template <class S>
 void edge_multiply(const EdgeModel<S>& m, const EdgeStiffness<S>& K, const S* x, S* y) {
     const index_t nv = m.num_vertices;
