@@ -61,7 +61,7 @@ bool spd_inverse3(const double (&B)[3][3], double* inv) {
 // thread count.
 template <class Term>
 std::array<double, 3> blocked_sum3(const Executor& ex, std::size_t n, Term&& term) {
-    std::vector<std::array<double, 3>> partial((n + kVectorBlock - 1) / kVectorBlock, {0.0, 0.0, 0.0});
+    std::vector<std::array<double, 3>> partial(vector_blocks(n), {0.0, 0.0, 0.0});
     for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) {
         double acc[3] = {0, 0, 0};
         for (std::size_t i = lo; i < hi; ++i) term(i, acc);
@@ -522,7 +522,7 @@ struct Simulator<S>::Impl {
 
     void check_finite(long step_no) const {
         // First non-finite dof, found block-parallel.
-        const std::size_t chunks = (n() + kVectorBlock - 1) / kVectorBlock;
+        const std::size_t chunks = vector_blocks(n());
         std::vector<std::size_t> first(chunks, n());
         for_blocks(*exec, n(), [&](std::size_t lo, std::size_t hi) {
             for (std::size_t i = lo; i < hi; ++i)

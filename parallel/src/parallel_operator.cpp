@@ -39,7 +39,7 @@ index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const
         deformed_positions(mesh, u, xs, index_t(b), index_t(e));
     });
     const std::size_t nt = std::size_t(mesh.num_tets());
-    const std::size_t chunks = (nt + kVectorBlock - 1) / kVectorBlock;
+    const std::size_t chunks = vector_blocks(nt);
     std::vector<index_t> partial(chunks, 0);
     for_blocks(ex, nt, [&](std::size_t b, std::size_t e) {
         partial[b / kVectorBlock] = count_inverted_in(mesh, xs, index_t(b), index_t(e));

@@ -23,7 +23,7 @@ struct CgResult {
 struct CgWork {
     std::vector<double> r, z, p, Ap;  // double: the iteration's recurrences stay accurate for float A
     std::vector<double> keep;         // 1 on unknowns, 0 on constrained dofs
-    std::vector<double> partial;      // per-block partial sums (3 per block)
+    std::vector<double> partial;      // per-block partial sums (4 per block: p.Ap, r.r, r.z, b.b)
 };
 
 // n scalars; free_dof[i] != 0 for unknowns. The system matrix is applied in
@@ -39,7 +39,7 @@ struct CgWork {
 // Between two products an iteration is one pass of three phases over the
 // blocks, one parallel region with two barriers: (0) finish A p, partials
 // of p.Ap; (1) alpha, x and r updated, partials of r.r, z = M^-1 r,
-// partials of r.z; (2) beta, p updated. Every block sums the partials in
+// partials of r.z; (2) beta, p updated. Every group sums the partials in
 // block order itself, so no serial section sits between the phases and the
 // sums are the same for any thread count. (On armadillo-7k a step's CG
 // vector work ran as ~7 whole-vector passes on one thread: its 6558 dofs
