@@ -162,7 +162,8 @@ private:
     // Owner variant: per vertex part, the first vertex whose segment reaches
     // past the part (the part's end when none). The segments before it run
     // the direct-only kernels: with the spill split in them (a run-time part
-    // end) K x measured 15 % slower on armadillo-7k.
+    // end) the loops run slower (K x on armadillo-7k: 46.1 against 44.3 us at
+    // 1 thread, on xyz strides).
     std::vector<index_t> spill_vertex_first_;
     mutable std::vector<double> spill_g_;
     // Owner variant with the tet-local form: the form's batches of each part
@@ -732,8 +733,8 @@ void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S*
             // pads its x range; runs its segments into y4 and its padded
             // spill window (the non-spilling ones in an out-of-line loop);
             // adds the incoming windows and copies its y range out. Bitwise
-            // the same as on xyz strides. armadillo-7k, 1 thread: 44.3 ->
-            // ~37 us (the extra barrier costs less at 2 threads than that).
+            // the same as on xyz strides. armadillo-7k: 44.6 -> 37.9 us at 1
+            // thread, 24.6 -> 22.0 at 2 (the third phase's barrier included).
             const ForwardSpill& vs = vspill_;
             const index_t P = vs.parts(), nv = m.num_vertices;
             Ks.x4.resize(4 * std::size_t(nv));
