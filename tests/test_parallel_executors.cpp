@@ -9,6 +9,7 @@
 
 #include "edgefem/core/cg.hpp"
 #include "edgefem/core/error.hpp"
+#include "edgefem/parallel/barrier_latency.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/variant.hpp"
 
@@ -152,6 +153,18 @@ TEST(Executors, ConjugateGradientSameBitsOnEveryExecutor) {
                 EXPECT_EQ(r.residual, r0.residual) << to_string(bk) << t;
                 EXPECT_TRUE(x == ref) << to_string(bk) << " " << t << " threads";
             }
+}
+
+// The barrier probe runs on every executor, and says what is wrong with
+// its arguments.
+TEST(Executors, PhaseBarrierProbe) {
+    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB}) {
+        const auto ex = make_executor(b, 2);
+        const double us = phase_barrier_us(*ex, 50, 3);
+        EXPECT_TRUE(std::isfinite(us) && us >= 0) << to_string(b) << " " << us;
+        EXPECT_THROW(phase_barrier_us(*ex, 0), InvalidArgument);
+        EXPECT_THROW(phase_barrier_us(*ex, 10, 0), InvalidArgument);
+    }
 }
 
 TEST(Executors, Names) {

@@ -21,6 +21,7 @@
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
+#include "edgefem/parallel/barrier_latency.hpp"
 #include "edgefem/parallel/stream_bandwidth.hpp"
 
 namespace edgefem::cli {
@@ -56,6 +57,26 @@ void print_header(const BenchOptions& opts, const Mesh& mesh) {
     print_kv("backend", opts.exec.describe());
 }
 
+// On more than one thread, what a phase boundary costs right before and
+// after the timed calls (barrier_latency.hpp says why).
+struct BarrierProbe {
+    std::shared_ptr<const Executor> ex;
+    bool on;
+    double before = 0, after = 0;
+    BarrierProbe(const ExecOptions& exec, std::shared_ptr<const Executor> e)
+        : ex(std::move(e)), on(exec.parallel_kernels() && ex->threads() > 1) {
+        if (on) before = phase_barrier_us(*ex);
+    }
+    void finish() {
+        if (on) after = phase_barrier_us(*ex);
+    }
+    void print() const {
+        if (!on) return;
+        print_kv("phase_barrier_us_before", fmt(before, 4));
+        print_kv("phase_barrier_us_after", fmt(after, 4));
+    }
+};
+
 // One semi-implicit step (dt = 1 ms) of the mesh standing on its lowest 1%
 // along z under gravity -z; the state moves on from call to call.
 template <class S>
@@ -69,7 +90,9 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     Simulator<S> sim(std::move(scene), ex, operator_factory<S>(opts.exec, ex, opts.model.layout_kind()));
 
     std::vector<int> iterations;  // of every call, warm-up included
+    BarrierProbe probe(opts.exec, ex);
     const std::vector<double> ns = time_calls(opts.seconds, [&] { iterations.push_back(sim.step().solver_iterations); });
+    probe.finish();
     iterations.erase(iterations.begin(), iterations.end() - std::ptrdiff_t(ns.size()));  // the timed calls'
     double mean_iterations = 0;
     for (int i : iterations) mean_iterations += i;
@@ -84,6 +107,7 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     print_kv("median_ns_per_tet", fmt(median / tets, 6));
     print_kv("cg_iterations", fmt(mean_iterations, 6));
     print_kv("cg_iterations_max", *std::max_element(iterations.begin(), iterations.end()));
+    probe.print();
 }
 
 // Bytes one call of `kernel` moves (compulsory and per-pass counts,
@@ -153,6 +177,7 @@ void run_bench(const BenchOptions& opts) {
     // seconds, so each round's calls are set against the triad measured
     // right after them, and the median of those paired fractions is
     // reported next to the fraction of the overall medians.
+    BarrierProbe probe(opts.exec, opts.exec.executor());
     const int rounds = opts.stream ? opts.stream_rounds : 1;
     std::vector<double> ns, round_fraction;
     std::vector<StreamBandwidth> sb;
@@ -166,6 +191,7 @@ void run_bench(const BenchOptions& opts) {
         }
         ns.insert(ns.end(), t.begin(), t.end());
     }
+    probe.finish();
     std::sort(ns.begin(), ns.end());
     const double median = median_of_sorted(ns);
     const double tets = mesh.num_tets();
@@ -183,6 +209,7 @@ void run_bench(const BenchOptions& opts) {
     print_kv("min_ms", fmt(ns.front() * 1e-6, 6));
     print_kv("median_ns_per_tet", fmt(median / tets, 6));
     print_kv("min_ns_per_tet", fmt(ns.front() / tets, 6));
+    probe.print();
     const double achieved = traffic.compulsory / median;  // bytes per ns = GB/s
     if (traffic.compulsory > 0) {
         print_kv("bytes_per_call", fmt(traffic.compulsory, 10));
