@@ -252,7 +252,8 @@ void add_bench_command(CLI::App& app) {
         "bench",
         "Time one kernel on the twist configuration, or one time step, on the chosen back-end (--backend, --threads, --variant): a warm-up, then "
         "calls until --seconds have passed (at least 5); reports the median and minimum per call and per tet, and for the edge method's force and kx the "
-        "bytes a call moves from memory (bytes_per_call) and the rate achieved (achieved_GB_per_s)");
+        "bytes a call moves from memory (bytes_per_call) and the rate achieved (achieved_GB_per_s); on more than one thread, what an "
+        "empty phase boundary costs before and after the timed calls (phase_barrier_us_before/after: where the threads sit)");
     opts->mesh.ordering = "rcm";  // the measured winner (docs/layouts.md), as simulate and static
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/false);
