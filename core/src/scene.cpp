@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/validate_mesh.hpp"
 
 namespace edgefem {
 
@@ -33,6 +34,18 @@ const char* to_string(LinearSolver s) { return s == LinearSolver::CG ? "cg" : "d
 void Scene::validate() const {
     const index_t nv = mesh.num_vertices();
     if (mesh.num_tets() == 0) bad("mesh", "the mesh has no tets");
+    // A Scene may be filled in by hand (or through a foreign-language
+    // binding), so the mesh is checked here, not only where files are read:
+    // an index out of range would otherwise reach the topology build.
+    check_mesh(mesh);
+    // Enums that came in as integers (bindings, casts) must name a value.
+    if (model != ModelKind::FE && model != ModelKind::SN) bad("model", "not a model (fe or sn)");
+    if (method != Method::Edge && method != Method::Tet) bad("method", "not a method (edge or tet)");
+    if (integrator != Integrator::Explicit && integrator != Integrator::SemiImplicit &&
+        integrator != Integrator::Implicit)
+        bad("integrator", "not an integrator (explicit, semi-implicit or implicit)");
+    if (solver.linear_solver != LinearSolver::CG && solver.linear_solver != LinearSolver::Direct)
+        bad("solver.linear_solver", "not a linear solver (cg or direct)");
     materials.validate();
     for (int r = 0; r < 3; ++r)
         if (!std::isfinite(gravity[r])) bad("gravity", "non-finite component");

@@ -164,9 +164,9 @@ void handle_unreferenced(Mesh& mesh, const ValidationOptions& options, Validatio
     report.removed_vertices = unused;
 }
 
-}  // namespace
-
-ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options) {
+// Every check that needs no change to the mesh; returns the negatively
+// oriented tets (not an error here: validate_mesh may flip them).
+std::vector<index_t> check_all_but_orientation(const Mesh& mesh, const ValidationOptions& options) {
     check_structure(mesh);
     check_indices(mesh);
     check_finite(mesh);
@@ -206,15 +206,23 @@ ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options) {
     }
 
     check_duplicates(mesh);
+    return inverted;
+}
 
+[[noreturn]] void throw_inverted(const Mesh& mesh, const std::vector<index_t>& inverted) {
+    throw MeshError(std::to_string(inverted.size()) + " of " + std::to_string(mesh.num_tets()) +
+                        " tets are inverted (negative volume); the first is " + mesh.describe_tet(inverted.front()) +
+                        ". Enable the fix-orientation option (ValidationOptions::fix_orientation, CLI --fix-orientation) to flip them",
+                    {}, 0, inverted.front());
+}
+
+}  // namespace
+
+ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options) {
+    const std::vector<index_t> inverted = check_all_but_orientation(mesh, options);
     ValidationReport report;
     if (!inverted.empty()) {
-        if (!options.fix_orientation)
-            throw MeshError(std::to_string(inverted.size()) + " of " + std::to_string(nt) +
-                                " tets are inverted (negative volume); the first is " +
-                                mesh.describe_tet(inverted.front()) +
-                                ". Enable the fix-orientation option (ValidationOptions::fix_orientation, CLI --fix-orientation) to flip them",
-                            {}, 0, inverted.front());
+        if (!options.fix_orientation) throw_inverted(mesh, inverted);
         for (const index_t t : inverted)
             std::swap(mesh.tets[4 * static_cast<std::size_t>(t) + 2],
                       mesh.tets[4 * static_cast<std::size_t>(t) + 3]);
@@ -225,6 +233,11 @@ ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options) {
     }
     handle_unreferenced(mesh, options, report);
     return report;
+}
+
+void check_mesh(const Mesh& mesh, const ValidationOptions& options) {
+    const std::vector<index_t> inverted = check_all_but_orientation(mesh, options);
+    if (!inverted.empty()) throw_inverted(mesh, inverted);
 }
 
 }  // namespace edgefem

@@ -84,7 +84,10 @@ struct Scene {
     SolverSettings solver;
     bool count_inverted_tets = true;         // per-step statistic (one pass over the tets)
 
-    // Throws InvalidArgument naming the field (e.g. "dt", "fixed[3]").
+    // Throws InvalidArgument naming the field (e.g. "dt", "fixed[3]"), and
+    // MeshError for a mesh that check_mesh rejects (validate_mesh.hpp: an
+    // index out of range, a non-finite coordinate, a degenerate, duplicate
+    // or inverted tet). Every Simulator runs it.
     void validate() const;
 };
 

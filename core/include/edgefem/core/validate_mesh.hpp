@@ -34,4 +34,10 @@ struct ValidationReport {
 // as the options ask.
 ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options = {});
 
+// The same checks on a mesh that must not change (Scene::validate, and so
+// every Simulator, runs it): negatively oriented tets are an error whatever
+// fix_orientation says, unreferenced vertices are left to the caller
+// (the Simulator rejects them: a vertex without mass).
+void check_mesh(const Mesh& mesh, const ValidationOptions& options = {});
+
 }  // namespace edgefem
