@@ -105,6 +105,25 @@ TEST(Ordering, OrderedSimulatorIsInvisibleToTheUser) {
     }
 }
 
+// Arrays of the wrong length are errors, not reads or writes past their end.
+TEST(Ordering, OrderedSimulatorChecksArrayLengths) {
+    const Scene s = edgefem::test::clamped_box_scene(6, 2, 2);
+    OrderedSimulator<double> sim(s, Ordering::RCM);
+    const std::size_t n = 3 * std::size_t(s.mesh.num_vertices());
+    for (const std::size_t len : {std::size_t(0), std::size_t(6), n - 1, n + 3}) {
+        std::vector<double> a(len, 0.0);
+        EXPECT_THROW(sim.set_displacement(a), InvalidArgument) << len;
+        EXPECT_THROW(sim.set_velocity(a), InvalidArgument) << len;
+        EXPECT_THROW(sim.set_external_forces(a), InvalidArgument) << len;
+        EXPECT_THROW(sim.get_displacement(a), InvalidArgument) << len;
+        EXPECT_THROW(sim.get_velocity(a), InvalidArgument) << len;
+        EXPECT_THROW(sim.get_forces(a), InvalidArgument) << len;
+    }
+    std::vector<double> a(n, 0.0);
+    EXPECT_NO_THROW(sim.set_displacement(a));
+    EXPECT_NO_THROW(sim.get_forces(a));
+}
+
 // An explicit step far past the stability limit: the error an
 // OrderedSimulator throws names the vertex in the user's numbering (vertex()
 // and the message), the one the simulator on the renumbered scene names.

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <string>
 
+#include "edgefem/core/error.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 
 namespace edgefem {
@@ -17,8 +18,15 @@ Scene permute_scene(const Scene& scene, const std::vector<index_t>& new_of_old) 
 }
 
 namespace {
+// The user's array must hold 3 values per vertex: checked, as the C API's
+// counts are, since a short span would be read or written past its end.
 template <class From, class To>
 void gather(std::span<const From> in, std::span<To> out, const std::vector<index_t>& new_of_old, bool to_internal_order) {
+    const std::size_t n = 3 * new_of_old.size();
+    const std::size_t given = to_internal_order ? in.size() : out.size();
+    if (given != n)
+        throw InvalidArgument("expected 3 x #V = " + std::to_string(n) + " values (one xyz per vertex), got " +
+                              std::to_string(given));
     for (std::size_t v = 0; v < new_of_old.size(); ++v)
         for (int r = 0; r < 3; ++r) {
             const std::size_t user = 3 * v + r, internal = 3 * std::size_t(new_of_old[v]) + r;

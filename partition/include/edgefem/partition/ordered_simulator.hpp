@@ -31,7 +31,7 @@ public:
     Energies energies() { return sim_.energies(); }
     double time() const { return sim_.time(); }
 
-    // 3 #V values, user numbering.
+    // 3 #V values, user numbering; another length throws InvalidArgument.
     void get_displacement(std::span<double> out) const;
     void set_displacement(std::span<const double> in);
     void get_velocity(std::span<double> out) const;
