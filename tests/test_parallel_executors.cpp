@@ -183,6 +183,17 @@ TEST(Executors, Names) {
     EXPECT_STREQ(make_executor(Backend::OpenMP, 2)->name(), "omp");
 }
 
+// OpenMP starts as many threads as asked (1e5 crashed in libgomp): past
+// kMaxThreads both back-ends refuse; oversubscription below it is fine.
+TEST(Executors, ThreadLimit) {
+    for (Backend b : {Backend::OpenMP, Backend::TBB}) {
+        EXPECT_THROW(make_executor(b, kMaxThreads + 1), InvalidArgument) << to_string(b);
+        EXPECT_THROW(make_executor(b, 100000), InvalidArgument) << to_string(b);
+        EXPECT_EQ(make_executor(b, 16)->threads(), 16) << to_string(b);
+    }
+    EXPECT_NO_THROW(make_executor(Backend::Serial, 100000));  // serial ignores the count
+}
+
 // Two TBB executors with different thread counts coexist (each its arena).
 TEST(Executors, IndependentArenas) {
     const auto a = make_executor(Backend::TBB, 2), b = make_executor(Backend::TBB, 3);

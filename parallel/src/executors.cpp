@@ -9,6 +9,7 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
+#include <string>
 #include <thread>
 
 #include "edgefem/core/error.hpp"
@@ -45,8 +46,18 @@ int hardware_threads() {
 
 // ---- OpenMP ---------------------------------------------------------------
 
+namespace {
+int checked_threads(int threads, int all) {
+    if (threads > kMaxThreads)
+        throw InvalidArgument("threads: " + std::to_string(threads) + " is more than the limit of " +
+                              std::to_string(kMaxThreads) + " (this machine has " + std::to_string(hardware_threads()) +
+                              " hardware threads)");
+    return threads > 0 ? threads : all;
+}
+}  // namespace
+
 OmpExecutor::OmpExecutor(int threads, Schedule schedule)
-    : ScheduledExecutor(threads > 0 ? threads : omp_get_max_threads(), schedule) {}
+    : ScheduledExecutor(checked_threads(threads, omp_get_max_threads()), schedule) {}
 
 // Every parallel region has the full team, also when a pass has fewer
 // chunks than threads: libgomp keeps its pool only while consecutive
@@ -109,7 +120,7 @@ struct TbbExecutor::Impl {
 };
 
 TbbExecutor::TbbExecutor(int threads, Schedule schedule)
-    : ScheduledExecutor(threads > 0 ? threads : tbb::info::default_concurrency(), schedule),
+    : ScheduledExecutor(checked_threads(threads, tbb::info::default_concurrency()), schedule),
       impl_(std::make_unique<Impl>(threads_)) {}
 
 TbbExecutor::~TbbExecutor() = default;

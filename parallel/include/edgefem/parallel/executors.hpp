@@ -57,9 +57,16 @@ protected:
     Schedule schedule_;
 };
 
+// The most threads an executor accepts (InvalidArgument above it): OpenMP
+// starts as many threads as asked, and 1e5 of them overflowed libgomp's
+// stack (a crash, not an error); no shared-memory machine this targets has
+// more hardware threads. Oversubscription below it stays allowed (the tests
+// run 8 threads on 2 cores).
+inline constexpr int kMaxThreads = 1024;
+
 class OmpExecutor final : public ScheduledExecutor {
 public:
-    // threads <= 0: omp_get_max_threads().
+    // threads <= 0: omp_get_max_threads(); more than kMaxThreads: InvalidArgument.
     explicit OmpExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
     const char* name() const override { return "omp"; }
 
@@ -72,7 +79,8 @@ private:
 
 class TbbExecutor final : public ScheduledExecutor {
 public:
-    // threads <= 0: the default concurrency. TBB never runs more threads
+    // threads <= 0: the default concurrency; more than kMaxThreads:
+    // InvalidArgument. TBB never runs more threads
     // than its global limit (the hardware threads unless the application
     // raises it with tbb::global_control): a larger count is accepted and
     // splits the work the same way, on fewer threads.
