@@ -90,11 +90,13 @@ void require_count(size_t count, size_t expected, const char* name) {
                 std::to_string(expected));
 }
 
-void require_finite(const double* a, size_t n, const char* name) {
+// `per_vertex`: a is xyz per vertex, and the message names the vertex too
+// (for one vector, such as gravity, a vertex would mean nothing).
+void require_finite(const double* a, size_t n, const char* name, bool per_vertex = true) {
     for (size_t i = 0; i < n; ++i)
         if (!std::isfinite(a[i]))
-            invalid(std::string(name) + "[" + std::to_string(i) + "] is not finite (vertex " +
-                    std::to_string(i / 3) + ")");
+            invalid(std::string(name) + "[" + std::to_string(i) + "] is not finite" +
+                    (per_vertex ? " (vertex " + std::to_string(i / 3) + ")" : std::string()));
 }
 
 edgefem::Scene default_scene_for(edgefem::Mesh mesh) {
@@ -239,7 +241,7 @@ edgefem_status edgefem_scene_set_gravity(edgefem_scene* scene, double gx, double
     return guard("edgefem_scene_set_gravity", [&] {
         require(scene, "scene");
         const double g[3] = {gx, gy, gz};
-        require_finite(g, 3, "gravity");
+        require_finite(g, 3, "gravity", false);
         scene->scene.gravity = {gx, gy, gz};
     });
 }
@@ -360,7 +362,10 @@ edgefem_status edgefem_sim_set_external_force(edgefem_sim* sim, int32_t vertex, 
         if (vertex < 0 || vertex >= nv)
             invalid("vertex " + std::to_string(vertex) + " is out of range [0, " + std::to_string(nv) + ")");
         const double f[3] = {fx, fy, fz};
-        require_finite(f, 3, "force");
+        for (int r = 0; r < 3; ++r)
+            if (!std::isfinite(f[r]))
+                invalid("the force on vertex " + std::to_string(vertex) + " is not finite (component " +
+                        std::to_string(r) + ")");
         auto fe = sim->sim.external_forces();
         for (int r = 0; r < 3; ++r) fe[3 * std::size_t(vertex) + r] = f[r];
     });

@@ -219,6 +219,12 @@ int main(void) {
                  "missing scene file");
     expect_error(edgefem_scene_set_integrator(scene, (edgefem_integrator)42), EDGEFEM_ERROR_INVALID_ARGUMENT,
                  "integrator", "unknown integrator");
+    /* One vector: the message names the component, not a "vertex". */
+    expect_error(edgefem_scene_set_gravity(scene, 0, NAN, 0), EDGEFEM_ERROR_INVALID_ARGUMENT, "gravity[1] is not finite",
+                 "NaN gravity");
+    CHECK(strstr(edgefem_last_error(), "vertex") == NULL);
+    expect_error(edgefem_sim_set_external_force(sim, 2, 0, NAN, 0), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                 "force on vertex 2 is not finite", "NaN force on one vertex");
 
     /* An explicit step far beyond the stability limit fails as a simulation error. */
     edgefem_scene* stiff = NULL;
@@ -232,6 +238,20 @@ int main(void) {
     edgefem_status st = EDGEFEM_OK;
     for (int k = 0; k < 200 && st == EDGEFEM_OK; ++k) st = edgefem_sim_step(unstable, NULL);
     expect_error(st, EDGEFEM_ERROR_SIMULATION, "step", "unstable explicit step");
+    /* The failed step left the state of the step before it: finite. */
+    {
+        int32_t unv = 0;
+        CHECK_OK(edgefem_sim_num_vertices(unstable, &unv));
+        double* ux = malloc(sizeof(double) * 3 * (size_t)unv);
+        CHECK_OK(edgefem_sim_get_positions(unstable, ux, 3 * (size_t)unv));
+        int finite = 1;
+        for (int32_t i = 0; i < 3 * unv; ++i) finite = finite && isfinite(ux[i]);
+        CHECK(finite);
+        edgefem_energies ue;
+        CHECK_OK(edgefem_sim_energies(unstable, &ue));
+        CHECK(isfinite(ue.total));
+        free(ux);
+    }
     edgefem_sim_destroy(unstable);
     edgefem_scene_destroy(stiff);
 
