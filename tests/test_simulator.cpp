@@ -2,6 +2,7 @@
 // the definite tangent, and clear failures.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -562,4 +563,125 @@ TEST(Simulator, NewtonAcceptsItsRoundOffFloorButNotAStuckSolve) {
     const StepStats& ps = plain.step();
     EXPECT_FALSE(ps.newton_round_off);
     EXPECT_LE(ps.residual, ok.solver.newton_tolerance);
+}
+
+// A Scene filled in by hand reaches the Simulator without a reader's
+// validation: every mesh fault is a MeshError naming it, never a crash in
+// the topology build or silent nonsense (an inverted or duplicate tet).
+TEST(Simulator, HandMadeSceneMeshIsChecked) {
+    const auto expect_mesh_error = [](Scene s, const std::string& what) {
+        try {
+            Simulator<double> sim(std::move(s));
+            ADD_FAILURE() << "accepted: " << what;
+        } catch (const MeshError& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    };
+    const Scene good = cantilever(Integrator::SemiImplicit, 1e-3);
+    Scene s = good;
+    s.mesh.tets[5] = -5;
+    expect_mesh_error(s, "out of range");
+    s = good;
+    s.mesh.tets[6] = s.mesh.num_vertices();
+    expect_mesh_error(s, "out of range");
+    s = good;
+    s.mesh.tets[1] = s.mesh.tets[0];
+    expect_mesh_error(s, "twice");
+    s = good;
+    s.mesh.X[4] = std::numeric_limits<double>::quiet_NaN();
+    expect_mesh_error(s, "non-finite");
+    s = good;
+    s.mesh.region.assign(1, 0);
+    expect_mesh_error(s, "region ids");
+    s = good;
+    s.mesh.X.push_back(0.0);
+    expect_mesh_error(s, "multiple of 3");
+    s = good;
+    std::swap(s.mesh.tets[2], s.mesh.tets[3]);
+    expect_mesh_error(s, "inverted");
+    s = good;
+    s.mesh.tets.insert(s.mesh.tets.end(), s.mesh.tets.begin(), s.mesh.tets.begin() + 4);
+    expect_mesh_error(s, "duplicates");
+    s = good;
+    for (int r = 0; r < 3; ++r) s.mesh.X[3 * s.mesh.tets[3] + r] = s.mesh.X[3 * s.mesh.tets[2] + r];  // flat tet 0
+    expect_mesh_error(s, "degenerate");
+}
+
+// Enums that arrive as integers (bindings, casts) must name a value.
+TEST(Simulator, OutOfRangeEnumsAreErrors) {
+    const auto expect_field = [](Scene s, const char* field) {
+        try {
+            Simulator<double> sim(std::move(s));
+            ADD_FAILURE() << "accepted bad " << field;
+        } catch (const InvalidArgument& e) {
+            EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+        }
+    };
+    Scene s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.integrator = static_cast<Integrator>(7);
+    expect_field(s, "\"integrator\"");
+    s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.model = static_cast<ModelKind>(-1);
+    expect_field(s, "\"model\"");
+    s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.method = static_cast<Method>(2);
+    expect_field(s, "\"method\"");
+    s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.solver.linear_solver = static_cast<LinearSolver>(9);
+    expect_field(s, "\"solver.linear_solver\"");
+}
+
+// A step that fails leaves the state as it found it (u, v, time, step
+// index, bit for bit), so the application can remove the cause and go on;
+// before, the exploded state stayed and the next step started from it.
+TEST(Simulator, FailedStepLeavesTheStateUntouched) {
+    for (const Integrator integrator : {Integrator::Explicit, Integrator::SemiImplicit, Integrator::Implicit}) {
+        Scene s = cantilever(integrator, 1e-3);
+        if (integrator == Integrator::Implicit) s.solver.newton_max_iterations = 3;
+        Simulator<double> sim(std::move(s));
+        for (int k = 0; k < 3; ++k) sim.step();
+        const std::vector<double> u0(sim.displacement().begin(), sim.displacement().end());
+        const std::vector<double> v0(sim.velocity().begin(), sim.velocity().end());
+        const double t0 = sim.time();
+        const long k0 = sim.step_index();
+        const std::size_t tip = sim.displacement().size() - 3;
+        sim.external_forces()[tip] = 1e12;  // tears the tip off in one step
+        EXPECT_THROW(sim.step(), SimulationError) << to_string(integrator);
+        EXPECT_EQ(sim.time(), t0);
+        EXPECT_EQ(sim.step_index(), k0);
+        EXPECT_TRUE(std::equal(u0.begin(), u0.end(), sim.displacement().begin())) << to_string(integrator);
+        EXPECT_TRUE(std::equal(v0.begin(), v0.end(), sim.velocity().begin())) << to_string(integrator);
+        const Energies e = sim.energies();
+        EXPECT_TRUE(std::isfinite(e.elastic) && std::isfinite(e.kinetic));
+        sim.external_forces()[tip] = 0;
+        EXPECT_NO_THROW(sim.step()) << to_string(integrator);
+        EXPECT_EQ(sim.step_index(), k0 + 1);
+    }
+}
+
+// Energies too large for floating point are said to be, not printed as NaN.
+TEST(Simulator, NonFiniteEnergyIsNamed) {
+    Scene s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.gravity = {0, 0, -1e300};
+    Simulator<double> sim(std::move(s));
+    try {
+        for (int k = 0; k < 5; ++k) sim.step();
+        FAIL() << "no error";
+    } catch (const SimulationError& e) {
+        const std::string msg = e.what();
+        EXPECT_EQ(msg.find("nan"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("no longer finite"), std::string::npos) << msg;
+        EXPECT_GE(e.vertex(), 0) << msg;
+    }
+}
+
+TEST(Simulator, MovedFromSimulatorThrows) {
+    Simulator<double> a(cantilever(Integrator::SemiImplicit, 1e-3));
+    Simulator<double> b(std::move(a));
+    EXPECT_THROW(a.step(), Error);
+    EXPECT_THROW(a.displacement(), Error);
+    EXPECT_THROW(a.energies(), Error);
+    EXPECT_NO_THROW(b.step());
+    a = std::move(b);
+    EXPECT_NO_THROW(a.step());
 }

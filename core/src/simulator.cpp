@@ -138,6 +138,7 @@ struct Simulator<S>::Impl {
     std::vector<double> mass;                     // #V
     std::vector<double> mass_dof;                 // 3 #V: mass per dof, for loops that vectorise
     std::vector<S> u, v, fext, f;                 // 3 #V
+    std::vector<S> step_start_u, step_start_v;    // the state before the step (restored when it fails)
     std::vector<std::uint8_t> free_dof;           // 3 #V
     std::vector<index_t> con_vertex;              // fixed and prescribed vertices
     std::vector<std::array<double, 3>> con_disp;  // their final displacement
@@ -485,7 +486,19 @@ struct Simulator<S>::Impl {
             // dissipative: measured, never failed (as fail_on_unconverged).
             const bool partial = scene.integrator == Integrator::SemiImplicit && scene.solver.cg_fixed_iterations > 0 &&
                                  scene.solver.linear_solver == LinearSolver::CG;
-            if (!partial && !(excess <= (limit - 1) * scale + noise)) {  // NaN included
+            if (!partial && !std::isfinite(excess)) {
+                // State finite but its energy not (|u| ~ 1e300 under a huge
+                // load): say so rather than print a NaN ratio.
+                const index_t vertex = fastest_vertex();
+                double umax = 0;
+                for (const S x : u) umax = std::max(umax, std::abs(double(x)));
+                throw StepFailure{"step " + std::to_string(step + 1) +
+                                      ": the energy is no longer finite (displacements up to " + sci(umax) +
+                                      " m): the state left the range of floating point; fastest vertex " +
+                                      std::to_string(vertex) + " (check the loads, the units and dt)",
+                                  vertex};
+            }
+            if (!partial && !(excess <= (limit - 1) * scale + noise)) {
                 const index_t vertex = fastest_vertex();
                 char ratio[48], lim[32];
                 std::snprintf(ratio, sizeof ratio, "+%.3g x", excess / std::max(scale, 1e-300));
@@ -784,7 +797,8 @@ struct Simulator<S>::Impl {
     }
 
     void advance(double T, int depth) {
-        // The state is saved only when a failed step may be retried.
+        // The state is saved only when a failed step may be retried (the
+        // whole step's start is kept by do_step).
         const bool may_retry = depth < scene.solver.max_step_halvings;
         std::vector<S> u_save, v_save;
         if (may_retry) {
@@ -824,10 +838,19 @@ struct Simulator<S>::Impl {
     const StepStats& do_step() {
         stats = StepStats{};
         const double t_start = time;
+        // The state before the step, restored when it fails: a failed step
+        // left its rejected (often exploded) state behind, and a later step
+        // or energies() went on from it as if nothing had happened.
+        // Persistent buffers: one copy per step, no allocation.
+        step_start_u.assign(u.begin(), u.end());
+        step_start_v.assign(v.begin(), v.end());
         try {
             advance(scene.dt, 0);
         } catch (const StepFailure& failure) {
             time = t_start;
+            u.assign(step_start_u.begin(), step_start_u.end());
+            v.assign(step_start_v.begin(), step_start_v.end());
+            forces_current = false;
             throw SimulationError(failure.message, step + 1, failure.vertex);
         }
         time = t_start + scene.dt;  // no drift from summed halves
@@ -857,7 +880,7 @@ struct Simulator<S>::Impl {
                 u = u_save;
                 if (++halvings > 12)
                     throw SimulationError("static solve: " + failure.message + " even with load increment " +
-                                              std::to_string(inc),
+                                              sci(inc) + " (after 12 halvings)",
                                           step, failure.vertex);
                 inc /= 2;
                 continue;
@@ -891,71 +914,76 @@ Simulator<S>::Simulator(Scene scene, std::shared_ptr<const Executor> executor, O
 template <class S>
 Simulator<S>::~Simulator() = default;
 template <class S>
+typename Simulator<S>::Impl& Simulator<S>::self() const {
+    if (!impl_) throw Error("Simulator: used after it was moved from");
+    return *impl_;
+}
+template <class S>
 Simulator<S>::Simulator(Simulator&&) noexcept = default;
 template <class S>
 Simulator<S>& Simulator<S>::operator=(Simulator&&) noexcept = default;
 
 template <class S>
 const Scene& Simulator<S>::scene() const {
-    return impl_->scene;
+    return self().scene;
 }
 template <class S>
 index_t Simulator<S>::num_vertices() const {
-    return impl_->scene.mesh.num_vertices();
+    return self().scene.mesh.num_vertices();
 }
 template <class S>
 const StepStats& Simulator<S>::step() {
-    return impl_->do_step();
+    return self().do_step();
 }
 template <class S>
 StaticResult Simulator<S>::solve_static() {
     try {
-        return impl_->do_static();
+        return self().do_static();
     } catch (const StepFailure& failure) {
-        throw SimulationError("static solve: " + failure.message, impl_->step, failure.vertex);
+        throw SimulationError("static solve: " + failure.message, self().step, failure.vertex);
     }
 }
 template <class S>
 std::span<S> Simulator<S>::displacement() {
-    return impl_->u;
+    return self().u;
 }
 template <class S>
 std::span<S> Simulator<S>::velocity() {
-    return impl_->v;
+    return self().v;
 }
 template <class S>
 std::span<S> Simulator<S>::external_forces() {
-    return impl_->fext;
+    return self().fext;
 }
 template <class S>
 std::span<const S> Simulator<S>::forces() const {
-    return impl_->f;
+    return self().f;
 }
 template <class S>
 std::span<const double> Simulator<S>::lumped_mass() const {
-    return impl_->mass;
+    return self().mass;
 }
 template <class S>
 std::vector<double> Simulator<S>::positions() const {
-    std::vector<double> x(impl_->n());
-    for (std::size_t i = 0; i < x.size(); ++i) x[i] = impl_->scene.mesh.X[i] + double(impl_->u[i]);
+    std::vector<double> x(self().n());
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = self().scene.mesh.X[i] + double(self().u[i]);
     return x;
 }
 template <class S>
 Energies Simulator<S>::energies() {
-    return impl_->energies();
+    return self().energies();
 }
 template <class S>
 long Simulator<S>::step_index() const {
-    return impl_->step;
+    return self().step;
 }
 template <class S>
 double Simulator<S>::time() const {
-    return impl_->time;
+    return self().time;
 }
 template <class S>
 const StepStats& Simulator<S>::last_stats() const {
-    return impl_->stats;
+    return self().stats;
 }
 
 template class Simulator<double>;

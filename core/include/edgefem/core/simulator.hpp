@@ -77,6 +77,8 @@ public:
     explicit Simulator(Scene scene, std::shared_ptr<const Executor> executor = nullptr,
                        OperatorFactory<S> factory = {});
     ~Simulator();
+    // A moved-from simulator may only be destroyed or assigned to: its other
+    // members throw Error.
     Simulator(Simulator&&) noexcept;
     Simulator& operator=(Simulator&&) noexcept;
 
@@ -86,7 +88,9 @@ public:
     // Advances by scene().dt with the scene's integrator; throws
     // SimulationError on non-finite state, a failed solve or energy grown
     // without a source (SolverSettings::max_energy_growth), after the
-    // allowed step halvings.
+    // allowed step halvings. A step that throws leaves the state (u, v,
+    // time, step_index) as it was before the call, so the application can
+    // change what made it fail (dt, loads) and step again.
     const StepStats& step();
     // Static equilibrium under gravity, external forces and the prescribed
     // targets (reached fully), by Newton with line search and automatic load
@@ -113,6 +117,9 @@ public:
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
+    // impl_, or an Error for a moved-from simulator (instead of a null
+    // dereference).
+    Impl& self() const;
 };
 
 extern template class Simulator<double>;
