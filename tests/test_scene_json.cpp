@@ -377,6 +377,27 @@ TEST(SceneJsonErrors, Mesh) {
     EXPECT_NO_THROW(parse(R"({"mesh": ")" + data_file("bad/inverted") + R"(", "mesh_options": {"fix_orientation": true}})"));
 }
 
+TEST(SceneJsonErrors, DeepNestingIsRefusedNotRecursedInto) {
+    // json::dump recursed once per level: 100000 levels overflowed the stack.
+    const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+    expect_error(scene("\"gravity\": " + deep), {"scene.json", "invalid JSON", "nested deeper than 64 levels"});
+    // Within the limit, a deep or long value is described, not dumped.
+    const std::string msg = expect_error(scene("\"gravity\": " + std::string(60, '[') + std::string(60, ']')),
+                                         {"\"gravity\"", "3 numbers", "got an array of 1 value"});
+    EXPECT_EQ(msg.find("[["), std::string::npos) << msg;
+    std::string long_array = "[0";
+    for (int i = 0; i < 1000; ++i) long_array += ", 0";
+    expect_error(scene("\"gravity\": " + long_array + "]"), {"\"gravity\"", "got an array of 1001 values"});
+    expect_error(scene(R"("fixed": {"vertices": [0], "box": {}})"), {"\"fixed\"", "got {\"box\":{},\"vertices\":[0]}"});
+}
+
+TEST(SceneJsonErrors, NumberOverflowNamesTheFileAndPosition) {
+    const std::string msg = expect_error(scene(R"("gravity": [0, 0, 1e400])"),
+                                         {"scene.json: invalid JSON: number overflow parsing '1e400' at line 1, column 45"});
+    EXPECT_EQ(msg.find("[json.exception"), std::string::npos) << msg;
+    expect_error("{\"mesh\": \"box:2x2x2\",\n  \"dt\": -1e999}", {"scene.json", "'-1e999' at line 2, column 14"});
+}
+
 TEST(SceneJsonErrors, BadJsonAndFiles) {
     const std::string msg = expect_error("{\"mesh\": \"box:2x2x2\",\n \"dt\": }", {"scene.json", "invalid JSON", "line 2"});
     EXPECT_EQ(msg.find("[json.exception"), std::string::npos) << msg;

@@ -35,8 +35,25 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 std::string item(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
 
-// A value as it appears in the file, shortened for messages.
+// True when `v` holds at most `budget` values nested at most `depth` deep:
+// small enough to quote. The budget bounds both the work and the recursion.
+bool small_value(const json& v, int depth, int& budget) {
+    if (--budget < 0) return false;
+    if (!v.is_structured()) return true;
+    if (depth == 0) return false;
+    for (const json& e : v)
+        if (!small_value(e, depth - 1, budget)) return false;
+    return true;
+}
+
+// A value as it appears in the file, shortened for messages. Large or deep
+// containers are only described: json::dump recurses once per level.
 std::string show(const json& v) {
+    int budget = 32;
+    if (!small_value(v, 3, budget)) {
+        const std::string n = std::to_string(v.size()), s = v.size() == 1 ? "" : "s";
+        return v.is_array() ? "an array of " + n + " value" + s : "an object with " + n + " key" + s;
+    }
     std::string s = v.dump();
     if (s.size() > 60) s = s.substr(0, 57) + "...";
     return s;
@@ -455,19 +472,87 @@ SceneFile parse(const Context& cx, const json& root) {
     return sf;
 }
 
+// ---- JSON text -------------------------------------------------------------
+
+// Far deeper than any scene needs; deeper input is refused at parse time so
+// that nothing later has to guard against deep recursion.
+constexpr int kMaxDepth = 64;
+
+// json::parse's DOM builder behind SAX events, so that nesting can be capped
+// and every failure keeps its byte offset (nlohmann's number-overflow
+// message has no position).
+class CappedDomBuilder {
+public:
+    explicit CappedDomBuilder(json& root) : dom_(root, /*allow_exceptions=*/false) {}
+
+    bool null() { return dom_.null(); }
+    bool boolean(bool v) { return dom_.boolean(v); }
+    bool number_integer(json::number_integer_t v) { return dom_.number_integer(v); }
+    bool number_unsigned(json::number_unsigned_t v) { return dom_.number_unsigned(v); }
+    bool number_float(json::number_float_t v, const std::string& s) { return dom_.number_float(v, s); }
+    bool string(json::string_t& v) { return dom_.string(v); }
+    bool binary(json::binary_t& v) { return dom_.binary(v); }
+    bool key(json::string_t& v) { return dom_.key(v); }
+    bool start_object(std::size_t n) { return enter() && dom_.start_object(n); }
+    bool start_array(std::size_t n) { return enter() && dom_.start_array(n); }
+    bool end_object() { --depth_; return dom_.end_object(); }
+    bool end_array() { --depth_; return dom_.end_array(); }
+    template <class Exception>
+    bool parse_error(std::size_t offset, const std::string& /*token*/, const Exception& e) {
+        offset_ = offset;
+        message_ = e.what();
+        return false;
+    }
+
+    bool too_deep() const { return too_deep_; }
+    std::size_t offset() const { return offset_; }
+    const std::string& message() const { return message_; }
+
+private:
+    bool enter() {
+        too_deep_ = ++depth_ > kMaxDepth;
+        return !too_deep_;
+    }
+
+    nlohmann::detail::json_sax_dom_parser<json> dom_;
+    int depth_ = 0;
+    bool too_deep_ = false;
+    std::size_t offset_ = 0;
+    std::string message_;
+};
+
+// " at line L, column C" of a byte offset into `text`, counted as nlohmann does.
+std::string position(const std::string& text, std::size_t offset) {
+    offset = std::min(offset, text.size());
+    std::size_t line = 1, line_start = 0;
+    for (std::size_t i = 0; i < offset; ++i)
+        if (text[i] == '\n') {
+            ++line;
+            line_start = i + 1;
+        }
+    return " at line " + std::to_string(line) + ", column " + std::to_string(offset - line_start);
+}
+
+json parse_json(const std::string& text, const std::string& source) {
+    json root;
+    CappedDomBuilder sax(root);
+    if (json::sax_parse(text, &sax, json::input_format_t::json, /*strict=*/true, /*ignore_comments=*/true))
+        return root;
+    if (sax.too_deep())
+        throw InvalidArgument(source + ": invalid JSON: nested deeper than " + std::to_string(kMaxDepth) + " levels");
+    // Drop nlohmann's "[json.exception.parse_error.101] " tag; its parse
+    // errors say where they are, its other errors do not.
+    std::string what = sax.message();
+    if (const auto p = what.find("] "); what.rfind("[json.exception", 0) == 0 && p != std::string::npos) what.erase(0, p + 2);
+    if (what.find(" at line ") == std::string::npos) what += position(text, sax.offset());
+    throw InvalidArgument(source + ": invalid JSON: " + what);
+}
+
 }  // namespace
 
 SceneFile parse_scene(const std::string& text, const std::string& base_dir, const std::string& source_name) {
     const Context cx{source_name, base_dir};
-    json root;
-    try {
-        root = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-    } catch (const json::parse_error& e) {
-        // Drop nlohmann's "[json.exception.parse_error.101] " tag.
-        std::string what = e.what();
-        if (const auto p = what.find("] "); what.rfind("[json.exception", 0) == 0 && p != std::string::npos) what.erase(0, p + 2);
-        throw InvalidArgument(source_name + ": invalid JSON: " + what);
-    }
+    const json root = parse_json(text, source_name);
     SceneFile sf = parse(cx, root);
     sf.path = source_name;
     return sf;
