@@ -391,6 +391,22 @@ TEST(SceneJsonErrors, DeepNestingIsRefusedNotRecursedInto) {
     expect_error(scene(R"("fixed": {"vertices": [0], "box": {}})"), {"\"fixed\"", "got {\"box\":{},\"vertices\":[0]}"});
 }
 
+TEST(SceneJsonErrors, IntegersPastInt64AreOutOfRange) {
+    // double(INT64_MAX) rounds up to 2^63: these used to pass the range check
+    // and wrap to vertex 0.
+    EXPECT_EQ(expect_error(scene(R"("fixed": {"vertices": [9223372036854775807]})"), {}),
+              "scene.json: \"fixed.vertices[0]\": vertex 9223372036854775807 out of range (mesh has 27 vertices)");
+    expect_error(scene(R"("fixed": {"vertices": [9.223372036854775807e18]})"), {"\"fixed.vertices[0]\"", "out of range (mesh has 27 vertices)"});
+    expect_error(scene(R"("fixed": {"vertices": [1e300]})"), {"\"fixed.vertices[0]\"", "out of range"});
+    expect_error(scene(R"("fixed": {"vertices": [18446744073709551615]})"), {"\"fixed.vertices[0]\"", "out of range"});
+    expect_error(scene(R"("fixed": {"vertices": [-9223372036854775808]})"), {"\"fixed.vertices[0]\"", "non-negative"});
+    expect_error(scene(R"("fixed": {"vertices": [-9.3e18]})"), {"\"fixed.vertices[0]\"", "non-negative"});
+    for (const char* big : {"9223372036854775807", "9.223372036854775807e18", "2147483648", "2147483648.0"})
+        expect_error(scene(std::string("\"steps\": ") + big), {"\"steps\"", "up to 2147483647"});
+    EXPECT_EQ(parse(scene(R"("steps": 2147483647)")).scene.steps, 2147483647);
+    expect_error(R"({"mesh": {"box": {"cells": [2, 9.3e18, 2]}}})", {"\"mesh.box.cells[1]\"", "up to 2147483647"});
+}
+
 TEST(SceneJsonErrors, NumberOverflowNamesTheFileAndPosition) {
     const std::string msg = expect_error(scene(R"("gravity": [0, 0, 1e400])"),
                                          {"scene.json: invalid JSON: number overflow parsing '1e400' at line 1, column 45"});

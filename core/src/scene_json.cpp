@@ -112,25 +112,34 @@ double get_number(const Context& cx, const json& v, const std::string& path, Ran
     return x;
 }
 
-// Integers may be written as 1000 or 1e3, not as 2.5.
+// 2^63: the first double past int64 (double(INT64_MAX) rounds up to it).
+constexpr double kTwo63 = 9223372036854775808.0;
+
+// Integers may be written as 1000 or 1e3, not as 2.5. Ranges are compared as
+// integers: a double cannot hold every int64, so comparing doubles would let
+// INT64_MAX through and overflow the cast.
 std::int64_t get_integer(const Context& cx, const json& v, const std::string& path, std::int64_t min,
                          std::int64_t max = std::numeric_limits<int>::max()) {
     const std::string want = min == 0 ? "a non-negative integer" : min == 1 ? "a positive integer"
                                                                             : "an integer >= " + std::to_string(min);
-    double x = 0;
-    if (v.is_number_integer()) {
-        // Unsigned values above int64 cannot be stored; they are out of range anyway.
-        if (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(max)) cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v));
-        x = double(v.get<std::int64_t>());
+    const auto too_big = [&] { cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v)); };
+    std::int64_t i = 0;
+    if (v.is_number_unsigned()) {
+        if (v.get<std::uint64_t>() > std::uint64_t(max)) too_big();
+        i = std::int64_t(v.get<std::uint64_t>());
+    } else if (v.is_number_integer()) {
+        i = v.get<std::int64_t>();
     } else if (v.is_number_float()) {
-        x = v.get<double>();
-        if (!std::isfinite(x) || x != std::floor(x)) cx.fail(path, "expected " + want + ", got " + show(v));
+        const double x = v.get<double>();
+        if (!std::isfinite(x) || x != std::floor(x) || x < -kTwo63) cx.fail(path, "expected " + want + ", got " + show(v));
+        if (x >= kTwo63) too_big();
+        i = static_cast<std::int64_t>(x);
     } else {
         cx.fail(path, "expected " + want + ", got " + show(v));
     }
-    if (x < double(min)) cx.fail(path, "expected " + want + ", got " + show(v));
-    if (x > double(max)) cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v));
-    return static_cast<std::int64_t>(x);
+    if (i < min) cx.fail(path, "expected " + want + ", got " + show(v));
+    if (i > max) too_big();
+    return i;
 }
 
 int get_int(const Context& cx, const json& v, const std::string& path, int min) {
@@ -236,8 +245,21 @@ Renumbering compaction_map(const Mesh& read, bool compact) {
     return r;
 }
 
-std::string out_of_range(std::int64_t v, index_t count) {
-    return "vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(count) + " vertices)";
+std::string out_of_range(const std::string& v, index_t count) {
+    return "vertex " + v + " out of range (mesh has " + std::to_string(count) + " vertices)";
+}
+
+std::string out_of_range(std::int64_t v, index_t count) { return out_of_range(std::to_string(v), count); }
+
+// A vertex index of the mesh as read: any integer from `count` up is out of
+// range, including whole numbers past int64 written as floats (9.3e18).
+index_t get_vertex(const Context& cx, const json& v, const std::string& path, index_t count) {
+    const bool huge = (v.is_number_float() && v.get<double>() >= kTwo63) ||
+                      (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<std::int64_t>::max()));
+    if (huge) cx.fail(path, out_of_range(show(v), count));
+    const std::int64_t i = get_integer(cx, v, path, 0, std::numeric_limits<std::int64_t>::max());
+    if (i >= count) cx.fail(path, out_of_range(i, count));
+    return index_t(i);
 }
 
 // One parsed line of a fixed (index) or prescribed (index x y z) file.
@@ -305,9 +327,7 @@ void add_fixed(const Context& cx, const json& sel, const std::string& path, cons
         const std::string key = join(path, "vertices");
         if (!vs->is_array() || vs->empty()) cx.fail(key, "expected a non-empty array of vertex indices, got " + show(*vs));
         for (std::size_t i = 0; i < vs->size(); ++i) {
-            const std::int64_t v = get_integer(cx, (*vs)[i], item(key, i), 0, std::numeric_limits<std::int64_t>::max());
-            if (v >= renumber.read_count) cx.fail(item(key, i), out_of_range(v, renumber.read_count));
-            add(index_t(v));
+            add(get_vertex(cx, (*vs)[i], item(key, i), renumber.read_count));
         }
     } else {
         const json& box = sel["box"];
