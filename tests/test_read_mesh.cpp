@@ -142,7 +142,10 @@ TEST(read_mesh_errors, MissingAndUnknownFiles) {
     expect_mesh_error([] { read_gmsh(data_file("no_such_mesh.msh")); }, {"no_such_mesh.msh"});
     expect_mesh_error([] { read_mesh(data_file("small.stl")); }, {"small.stl", "mesh format"});
     expect_mesh_error([] { read_mesh(data_file("x.meshb")); }, {"binary MEDIT"});
-    expect_mesh_error([] { read_medit(test::test_data_dir()); }, {"directory"});
+    expect_mesh_error([] { read_medit(test::test_data_dir()); }, {"is a directory, not a mesh file"});
+    // A device is never loaded: /dev/zero would be read until memory ran out.
+    expect_mesh_error([] { read_gmsh("/dev/zero"); }, {"/dev/zero: not a regular file"});
+    expect_mesh_error([] { read_tetgen("/dev/null"); }, {"/dev/null.node", "cannot open"});
 }
 
 TEST(read_mesh_errors, HandWrittenBadFiles) {

@@ -414,6 +414,24 @@ TEST(SceneJsonErrors, NumberOverflowNamesTheFileAndPosition) {
     expect_error("{\"mesh\": \"box:2x2x2\",\n  \"dt\": -1e999}", {"scene.json", "'-1e999' at line 2, column 14"});
 }
 
+TEST(SceneJsonErrors, FilesMustBeRegular) {
+    TempDir dir("scene_regular");
+    // /dev/zero never ends: it used to be read until memory ran out.
+    expect_error(scene(R"("fixed": {"file": "/dev/zero"})"), {"\"fixed.file\"", "/dev/zero: not a regular file"});
+    expect_error(scene(R"("prescribed": {"file": "/dev/zero"})"), {"\"prescribed.file\"", "not a regular file"});
+    // A directory is named for what it should have been.
+    expect_error(scene(R"("fixed": {"file": "."})"), {"\"fixed.file\"", "is a directory, not a fixed-vertex file"}, dir.path());
+    expect_error(scene(R"("prescribed": {"file": "."})"), {"is a directory, not a prescribed-vertex file"}, dir.path());
+    for (const char* bad : {"/dev/zero", "/dev/null"}) {
+        try {
+            load_scene(bad);
+            ADD_FAILURE() << "no error for " << bad;
+        } catch (const InvalidArgument& e) {
+            EXPECT_EQ(std::string(e.what()), std::string(bad) + ": not a regular file");
+        }
+    }
+}
+
 TEST(SceneJsonErrors, BadJsonAndFiles) {
     const std::string msg = expect_error("{\"mesh\": \"box:2x2x2\",\n \"dt\": }", {"scene.json", "invalid JSON", "line 2"});
     EXPECT_EQ(msg.find("[json.exception"), std::string::npos) << msg;

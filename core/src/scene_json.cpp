@@ -277,7 +277,7 @@ std::vector<IndexLine> read_index_file(const Context& cx, const std::string& key
     const char* what = coords ? "'index x y z'" : "a vertex index";
     std::vector<IndexLine> out;
     try {
-        detail::TextReader r(path, '#');
+        detail::TextReader r(path, '#', coords ? "prescribed-vertex file" : "fixed-vertex file");
         while (r.next_line()) {
             auto tok = r.tokens();
             IndexLine l{};
@@ -580,7 +580,10 @@ SceneFile parse_scene(const std::string& text, const std::string& base_dir, cons
 
 SceneFile load_scene(const std::string& path) {
     std::error_code ec;
-    if (fs::is_directory(path, ec)) throw InvalidArgument(path + ": is a directory, not a scene file");
+    const auto status = fs::status(path, ec);
+    if (fs::is_directory(status)) throw InvalidArgument(path + ": is a directory, not a scene file");
+    // A device or a pipe (/dev/zero) may never end; the whole file is loaded.
+    if (fs::exists(status) && !fs::is_regular_file(status)) throw InvalidArgument(path + ": not a regular file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InvalidArgument(path + ": cannot open scene file");
     std::ostringstream text;

@@ -41,10 +41,15 @@ std::size_t LineTokens::count() const {
     return n;
 }
 
-TextReader::TextReader(std::string path, char comment) : path_(std::move(path)), comment_(comment) {
+TextReader::TextReader(std::string path, char comment, const std::string& kind)
+    : path_(std::move(path)), comment_(comment) {
     std::error_code ec;
-    if (std::filesystem::is_directory(path_, ec))
-        throw MeshError("is a directory, not a mesh file", path_);
+    const auto status = std::filesystem::status(path_, ec);
+    if (std::filesystem::is_directory(status))
+        throw MeshError("is a directory, not a " + kind, path_);
+    // A device or a pipe (/dev/zero) may never end; the whole file is loaded.
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+        throw MeshError("not a regular file", path_);
     std::FILE* f = std::fopen(path_.c_str(), "rb");
     if (!f) throw MeshError(std::string("cannot open file: ") + std::strerror(errno), path_);
     const auto size = std::filesystem::file_size(path_, ec);

@@ -32,8 +32,9 @@ class TextReader {
 public:
     // Loads `path`; `comment` starts a comment running to the end of the line
     // ('\0': the format has no comments). Throws MeshError when the file
-    // cannot be read.
-    TextReader(std::string path, char comment);
+    // cannot be read or is not a regular file; `kind` names what the file
+    // should be ("mesh file") in those messages.
+    TextReader(std::string path, char comment, const std::string& kind = "mesh file");
 
     const std::string& path() const { return path_; }
     bool file_empty() const { return data_.empty(); }
