@@ -252,6 +252,14 @@ TEST(read_mesh_errors, EditedVariants) {
     expect_mesh_error([&] { read_tetgen(p); }, {"gap.node:5:", "consecutively", "expected 3, got 4"});
     p = tetgen("missing", replace_once(node, "3 0 0 0.1", "3 0 0"), ele);
     expect_mesh_error([&] { read_tetgen(p); }, {"missing.node:5:", "missing z coordinate"});
+    // In a file this small the byte-count check used to blame the count.
+    p = tetgen("tight", "5 3 0 0\n1 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n", "1 4\n1 1 2 3 4\n");
+    expect_mesh_error([&] { read_tetgen(p); }, {"tight.node:2:", "missing z coordinate"});
+    p = tetgen("tightattr", "2 3 1 0\n1 0 0 0\n2 1 0 0 5\n", "1 4\n1 1 2 3 4\n");
+    expect_mesh_error([&] { read_tetgen(p); }, {"tightattr.node:2:", "missing vertex attribute"});
+    // A count the remaining lines cannot hold is still blamed at once.
+    p = tetgen("count", "7 3 0 0\n1 0 0 0\n2 1 0 0\n", "1 4\n1 1 2 3 4\n");
+    expect_mesh_error([&] { read_tetgen(p); }, {"count.node:1:", "vertex count 7 is more than the rest of the file"});
     p = tetgen("attr", node, "3 4 1\n0 0 1 2 3   # no attribute here\n1 1 2 3 4 2\n2 0 2 1 5 1\n");
     expect_mesh_error([&] { read_tetgen(p); }, {"attr.ele:2:", "missing tet attribute"});
     p = tetgen("dim", replace_once(node, "6 3 0 0", "6 2 0 0"), ele);
