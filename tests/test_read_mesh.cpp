@@ -136,6 +136,27 @@ TEST(read_mesh, TetGenTenNodeTetsKeepCorners) {
     EXPECT_NE(report.warnings[0].find("10-node"), std::string::npos);
 }
 
+TEST(read_mesh, UpperCaseTetGenExtensions) {
+    edgefem::test::TempDir dir("readcase");
+    const std::string node = edgefem::test::slurp(data_file("small0.node"));
+    const std::string ele = edgefem::test::slurp(data_file("small0.ele"));
+    edgefem::test::spit(dir.file("UP.NODE"), node);
+    edgefem::test::spit(dir.file("UP.ELE"), ele);
+    // read_mesh detected these as TetGen, then looked for UP.NODE.node.
+    expect_small_mesh(read_mesh(dir.file("UP.NODE")), false);
+    expect_small_mesh(read_mesh(dir.file("UP.ELE")), false);
+    expect_small_mesh(read_mesh(dir.file("UP")), false);
+    const Mesh m = read_tetgen(dir.file("UP.ELE"));
+    EXPECT_EQ(m.source.vertex_file, dir.file("UP.NODE"));
+    EXPECT_EQ(m.source.tet_file, dir.file("UP.ELE"));
+    // Mixed case: the partner in the other case when that is the one present.
+    edgefem::test::spit(dir.file("mix.Node"), node);
+    edgefem::test::spit(dir.file("mix.ele"), ele);
+    expect_small_mesh(read_mesh(dir.file("mix.Node")), false);
+    edgefem::test::spit(dir.file("lone.NODE"), node);
+    expect_mesh_error([&] { read_mesh(dir.file("lone.NODE")); }, {"lone.ELE", "cannot open"});
+}
+
 TEST(read_mesh_errors, MissingAndUnknownFiles) {
     expect_mesh_error([] { read_tetgen(data_file("no_such_mesh")); },
                       {"no_such_mesh.node", "cannot open"});
