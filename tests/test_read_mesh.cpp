@@ -157,6 +157,78 @@ TEST(read_mesh, UpperCaseTetGenExtensions) {
     expect_mesh_error([&] { read_mesh(dir.file("lone.NODE")); }, {"lone.ELE", "cannot open"});
 }
 
+TEST(read_mesh, QuadraticTetsKeepCornersInGmshAndMedit) {
+    edgefem::test::TempDir dir("readp2");
+    const std::string msh = edgefem::test::slurp(data_file("small22.msh"));
+    // Gmsh type 11: the 4 corners, then 6 mid-edge nodes (here existing tags).
+    std::string m10 = replace_once(msh, "4 4 2 1 100 10 20 30 40", "4 11 2 1 100 10 20 30 40 7 7 7 7 7 7");
+    m10 = replace_once(m10, "6 4 2 2 100 20 30 40 55", "6 11 2 2 100 20 30 40 55 7 7 7 7 7 7");
+    edgefem::test::spit(dir.file("t10.msh"), m10);
+    ReadReport report;
+    const Mesh g = read_gmsh(dir.file("t10.msh"), &report);
+    EXPECT_EQ(g.tets, kTets);
+    EXPECT_EQ(g.region, kRegion);
+    EXPECT_EQ(report.skipped_elements, 4);
+    ASSERT_EQ(report.warnings.size(), 1u);
+    EXPECT_NE(report.warnings[0].find("10-node"), std::string::npos);
+    edgefem::test::spit(dir.file("undef10.msh"), replace_once(m10, "55 7 7 7 7 7 7", "55 7 7 7 7 7 99"));
+    expect_mesh_error([&] { read_gmsh(dir.file("undef10.msh")); }, {"undef10.msh:25:", "node tag 99"});
+    // MSH 4.1: a block of 10-node tets.
+    const std::string msh41 = edgefem::test::slurp(data_file("small41.msh"));
+    edgefem::test::spit(dir.file("t10_41.msh"),
+                        replace_once(msh41, "3 1 4 1\n2 101 102 103 104\n", "3 1 11 1\n2 101 102 103 104 105 105 105 105 105 105\n"));
+    EXPECT_EQ(read_gmsh(dir.file("t10_41.msh")).tets, kTets);
+
+    // MEDIT TetrahedraP2: the same, 10 indices and a reference per line.
+    const std::string medit = edgefem::test::slurp(data_file("small.mesh"));
+    std::string p2 = replace_once(medit, "TETRAHEDRA\n3\n1 2 3 4 1\n2 3 4 5 2\n1 3 2 6 1\n",
+                                  "TetrahedraP2\n3\n1 2 3 4 6 6 6 6 6 6 1\n2 3 4 5 1 1 1 1 1 1 2\n1 3 2 6 4 4 4 4 4 4 1\n");
+    edgefem::test::spit(dir.file("p2.mesh"), p2);
+    ReadReport mreport;
+    const Mesh m = read_medit(dir.file("p2.mesh"), &mreport);
+    EXPECT_EQ(m.tets, kTets);
+    EXPECT_EQ(m.region, kRegion);
+    ASSERT_EQ(mreport.warnings.size(), 1u);
+    EXPECT_NE(mreport.warnings[0].find("TetrahedraP2"), std::string::npos);
+    edgefem::test::spit(dir.file("p2range.mesh"), replace_once(p2, "2 3 4 5 1 1 1 1 1 1 2", "2 3 4 5 1 1 1 1 1 7 2"));
+    expect_mesh_error([&] { read_medit(dir.file("p2range.mesh")); }, {"p2range.mesh:28:", "vertex index 7"});
+}
+
+// Simulating the tets of a mesh that also has hexahedra, prisms or pyramids
+// would drop part of the body without a word: those are errors.
+TEST(read_mesh_errors, OtherVolumeElements) {
+    edgefem::test::TempDir dir("readvol");
+    const std::string msh = edgefem::test::slurp(data_file("small22.msh"));
+    auto p = dir.file("hex.msh");
+    edgefem::test::spit(p, replace_once(msh, "5 2 2 7 1 20 30 55", "5 5 2 1 100 10 20 30 40 55 7 10 20"));
+    expect_mesh_error([&] { read_mesh(p); },
+                      {"hex.msh:24:", "mesh has 1 x hexahedron (type 5)", "simulates tets only", "convert the mesh to tets"});
+    p = dir.file("mixed.msh");
+    std::string mixed = replace_once(msh, "$Elements\n7\n", "$Elements\n9\n");
+    mixed = replace_once(mixed, "$EndElements", "8 6 2 1 100 10 20 30 40 55 7\n9 7 2 1 100 10 20 30 40 55\n$EndElements");
+    mixed = replace_once(mixed, "3 2 2 7 1 10 20 30", "3 17 2 7 1 10 20 30 10 20 30 10 20 30 10 20 30 10 20 30 10 20 30 10 20");
+    edgefem::test::spit(p, mixed);
+    expect_mesh_error([&] { read_mesh(p); },
+                      {"mixed.msh:22:", "1 x prism (type 6), 1 x pyramid (type 7), 1 x 20-node hexahedron (type 17)"});
+    p = dir.file("unknown.msh");
+    edgefem::test::spit(p, replace_once(msh, "5 2 2 7 1 20 30 55", "5 200 2 7 1 20 30 55"));
+    expect_mesh_error([&] { read_mesh(p); }, {"unknown.msh:24:", "element type 200 is unknown"});
+    // MSH 4.1: the block's entity dimension says "volume" whatever the type.
+    const std::string msh41 = edgefem::test::slurp(data_file("small41.msh"));
+    p = dir.file("hex41.msh");
+    edgefem::test::spit(p, replace_once(msh41, "2 1 2 2\n", "3 1 5 2\n"));
+    expect_mesh_error([&] { read_mesh(p); }, {"hex41.msh:37:", "mesh has 2 x hexahedron (type 5)"});
+    p = dir.file("odd41.msh");
+    edgefem::test::spit(p, replace_once(msh41, "2 1 2 2\n", "3 1 300 2\n"));
+    expect_mesh_error([&] { read_mesh(p); }, {"odd41.msh:37:", "2 x element (type 300)"});
+    // MEDIT
+    const std::string medit = edgefem::test::slurp(data_file("small.mesh"));
+    p = dir.file("hex.mesh");
+    edgefem::test::spit(p, replace_once(medit, "End", "Hexahedra\n1\n1 2 3 4 5 6 1 2 0\nPrisms 1\n1 2 3 4 5 6 0\nEnd"));
+    expect_mesh_error([&] { read_mesh(p); },
+                      {"hex.mesh:30:", "mesh has 1 x Hexahedra, 1 x Prisms", "convert the mesh to tets"});
+}
+
 TEST(read_mesh_errors, MissingAndUnknownFiles) {
     expect_mesh_error([] { read_tetgen(data_file("no_such_mesh")); },
                       {"no_such_mesh.node", "cannot open"});
