@@ -327,6 +327,13 @@ TEST(read_mesh_errors, EditedVariants) {
     expect_mesh_error([&] { read_medit(p); }, {"notmedit.mesh:1:", "MeshVersionFormatted"});
     p = write("trunc.mesh", medit.substr(0, medit.find("TETRAHEDRA") + 13));
     expect_mesh_error([&] { read_medit(p); }, {"trunc.mesh:", "truncated"});
+    // A skipped section's count too large or too small: the message names it.
+    p = write("skipbig.mesh", replace_once(medit, "triangles\n2\n", "triangles\n5\n"));
+    expect_mesh_error([&] { read_medit(p); },
+                      {"skipbig.mesh:25:", "while skipping section triangles (5 items)", "found keyword 'TETRAHEDRA'"});
+    p = write("skipsmall.mesh", replace_once(medit, "triangles\n2\n", "triangles\n1\n"));
+    expect_mesh_error([&] { read_medit(p); },
+                      {"skipsmall.mesh:24:", "expected a section keyword, got '2'", "section triangles"});
 
     // Vega
     p = write("range.veg", replace_once(veg, "2 2 3 4 5", "2 2 3 4 0"));

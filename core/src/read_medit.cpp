@@ -104,6 +104,29 @@ void read_tets(detail::TextReader& r, Words& words, int nodes, Mesh& mesh, TetSe
     }
 }
 
+// Skips a section of `count` item lines. An item line starts with a number,
+// so a keyword where an item should be means the count is too large.
+void skip_items(detail::TextReader& r, const std::string& name, index_t count) {
+    const std::string context = "while skipping section " + name + " (" + std::to_string(count) + " items): ";
+    for (index_t i = 0; i < count; ++i) {
+        r.require_line("item " + std::to_string(i + 1) + " of section " + name);
+        const char c = r.line().front();
+        if (!(c == '-' || c == '+' || c == '.' || (c >= '0' && c <= '9')))
+            r.fail(context + "expected item " + std::to_string(i + 1) + ", found keyword '" +
+                   detail::quote(r.tokens().next()) + "'");
+    }
+}
+
+// A section keyword starts with a letter; a number there means the previous
+// section has more items than its count.
+void check_keyword(const detail::TextReader& r, std::string_view word, const std::string& previous) {
+    const char c = word.front();
+    if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z')) return;
+    std::string message = "expected a section keyword, got '" + detail::quote(word) + "'";
+    if (!previous.empty()) message += " (does section " + previous + " have more items than its count?)";
+    r.fail(message);
+}
+
 void read_vertices(detail::TextReader& r, Words& words, Mesh& mesh) {
     auto& src = mesh.source;
     const index_t n = r.check_count(words.next_int("the vertex count"), 3, "vertex");
@@ -160,6 +183,7 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
     for (;;) {
         const std::string_view word = words.next();
         if (word.empty()) break;  // End is optional
+        check_keyword(r, word, previous);
         const std::string kw = detail::ascii_lower(word);
         previous = detail::quote(word);
         if (kw == "end") break;
@@ -180,8 +204,7 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
             const std::int64_t count = words.next_int("the item count of section '" + previous + "'");
             const index_t n = r.check_count(count, 1, "'" + previous + "' item");
             words.end_of_header("the item count");
-            for (index_t i = 0; i < n; ++i)
-                r.require_line("item " + std::to_string(i + 1) + " of section " + previous);
+            skip_items(r, previous, n);
             if (is_volume_section(kw)) {
                 if (volume.empty()) first_volume_line = line;
                 volume[previous] += n;
