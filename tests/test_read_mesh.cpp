@@ -381,6 +381,20 @@ TEST(read_mesh_errors, EditedVariants) {
     expect_mesh_error([&] { read_tetgen(p); }, {"base1.ele:2:", "tet 0", "vertex index 0", "1..6"});
 }
 
+TEST(read_mesh_errors, MessagesQuoteTheFilesVertexNumbers) {
+    edgefem::test::TempDir dir("readdup");
+    const std::string node = edgefem::test::slurp(data_file("small1.node"));
+    edgefem::test::spit(dir.file("dup.node"), node);
+    edgefem::test::spit(dir.file("dup.ele"), "4 4\n1 1 2 3 4\n2 2 3 4 5\n3 1 3 2 6\n4 2 1 4 3\n");
+    Mesh m = read_tetgen(dir.file("dup"));
+    // 1-based file: the vertices are quoted 1..6, not 0..5.
+    expect_mesh_error([&] { validate_mesh(m); }, {"duplicates tet 0", "(same vertices 2 1 4 3)"});
+    edgefem::test::spit(dir.file("twice.node"), node);
+    edgefem::test::spit(dir.file("twice.ele"), "1 4\n1 1 2 6 6\n");
+    Mesh t = read_tetgen(dir.file("twice"));
+    expect_mesh_error([&] { validate_mesh(t); }, {"uses vertex 6 twice"});
+}
+
 TEST(read_mesh, SharedMeshesTetGenAndGmshAgree) {
     int found = 0;
     for (const char* name : {"box-1200", "spot-2k", "bunny-4k", "armadillo-7k"}) {
