@@ -136,13 +136,109 @@ TEST(read_mesh, TetGenTenNodeTetsKeepCorners) {
     EXPECT_NE(report.warnings[0].find("10-node"), std::string::npos);
 }
 
+TEST(read_mesh, UpperCaseTetGenExtensions) {
+    edgefem::test::TempDir dir("readcase");
+    const std::string node = edgefem::test::slurp(data_file("small0.node"));
+    const std::string ele = edgefem::test::slurp(data_file("small0.ele"));
+    edgefem::test::spit(dir.file("UP.NODE"), node);
+    edgefem::test::spit(dir.file("UP.ELE"), ele);
+    // read_mesh detected these as TetGen, then looked for UP.NODE.node.
+    expect_small_mesh(read_mesh(dir.file("UP.NODE")), false);
+    expect_small_mesh(read_mesh(dir.file("UP.ELE")), false);
+    expect_small_mesh(read_mesh(dir.file("UP")), false);
+    const Mesh m = read_tetgen(dir.file("UP.ELE"));
+    EXPECT_EQ(m.source.vertex_file, dir.file("UP.NODE"));
+    EXPECT_EQ(m.source.tet_file, dir.file("UP.ELE"));
+    // Mixed case: the partner in the other case when that is the one present.
+    edgefem::test::spit(dir.file("mix.Node"), node);
+    edgefem::test::spit(dir.file("mix.ele"), ele);
+    expect_small_mesh(read_mesh(dir.file("mix.Node")), false);
+    edgefem::test::spit(dir.file("lone.NODE"), node);
+    expect_mesh_error([&] { read_mesh(dir.file("lone.NODE")); }, {"lone.ELE", "cannot open"});
+}
+
+TEST(read_mesh, QuadraticTetsKeepCornersInGmshAndMedit) {
+    edgefem::test::TempDir dir("readp2");
+    const std::string msh = edgefem::test::slurp(data_file("small22.msh"));
+    // Gmsh type 11: the 4 corners, then 6 mid-edge nodes (here existing tags).
+    std::string m10 = replace_once(msh, "4 4 2 1 100 10 20 30 40", "4 11 2 1 100 10 20 30 40 7 7 7 7 7 7");
+    m10 = replace_once(m10, "6 4 2 2 100 20 30 40 55", "6 11 2 2 100 20 30 40 55 7 7 7 7 7 7");
+    edgefem::test::spit(dir.file("t10.msh"), m10);
+    ReadReport report;
+    const Mesh g = read_gmsh(dir.file("t10.msh"), &report);
+    EXPECT_EQ(g.tets, kTets);
+    EXPECT_EQ(g.region, kRegion);
+    EXPECT_EQ(report.skipped_elements, 4);
+    ASSERT_EQ(report.warnings.size(), 1u);
+    EXPECT_NE(report.warnings[0].find("10-node"), std::string::npos);
+    edgefem::test::spit(dir.file("undef10.msh"), replace_once(m10, "55 7 7 7 7 7 7", "55 7 7 7 7 7 99"));
+    expect_mesh_error([&] { read_gmsh(dir.file("undef10.msh")); }, {"undef10.msh:25:", "node tag 99"});
+    // MSH 4.1: a block of 10-node tets.
+    const std::string msh41 = edgefem::test::slurp(data_file("small41.msh"));
+    edgefem::test::spit(dir.file("t10_41.msh"),
+                        replace_once(msh41, "3 1 4 1\n2 101 102 103 104\n", "3 1 11 1\n2 101 102 103 104 105 105 105 105 105 105\n"));
+    EXPECT_EQ(read_gmsh(dir.file("t10_41.msh")).tets, kTets);
+
+    // MEDIT TetrahedraP2: the same, 10 indices and a reference per line.
+    const std::string medit = edgefem::test::slurp(data_file("small.mesh"));
+    std::string p2 = replace_once(medit, "TETRAHEDRA\n3\n1 2 3 4 1\n2 3 4 5 2\n1 3 2 6 1\n",
+                                  "TetrahedraP2\n3\n1 2 3 4 6 6 6 6 6 6 1\n2 3 4 5 1 1 1 1 1 1 2\n1 3 2 6 4 4 4 4 4 4 1\n");
+    edgefem::test::spit(dir.file("p2.mesh"), p2);
+    ReadReport mreport;
+    const Mesh m = read_medit(dir.file("p2.mesh"), &mreport);
+    EXPECT_EQ(m.tets, kTets);
+    EXPECT_EQ(m.region, kRegion);
+    ASSERT_EQ(mreport.warnings.size(), 1u);
+    EXPECT_NE(mreport.warnings[0].find("TetrahedraP2"), std::string::npos);
+    edgefem::test::spit(dir.file("p2range.mesh"), replace_once(p2, "2 3 4 5 1 1 1 1 1 1 2", "2 3 4 5 1 1 1 1 1 7 2"));
+    expect_mesh_error([&] { read_medit(dir.file("p2range.mesh")); }, {"p2range.mesh:28:", "vertex index 7"});
+}
+
+// Simulating the tets of a mesh that also has hexahedra, prisms or pyramids
+// would drop part of the body without a word: those are errors.
+TEST(read_mesh_errors, OtherVolumeElements) {
+    edgefem::test::TempDir dir("readvol");
+    const std::string msh = edgefem::test::slurp(data_file("small22.msh"));
+    auto p = dir.file("hex.msh");
+    edgefem::test::spit(p, replace_once(msh, "5 2 2 7 1 20 30 55", "5 5 2 1 100 10 20 30 40 55 7 10 20"));
+    expect_mesh_error([&] { read_mesh(p); },
+                      {"hex.msh:24:", "mesh has 1 x hexahedron (type 5)", "simulates tets only", "convert the mesh to tets"});
+    p = dir.file("mixed.msh");
+    std::string mixed = replace_once(msh, "$Elements\n7\n", "$Elements\n9\n");
+    mixed = replace_once(mixed, "$EndElements", "8 6 2 1 100 10 20 30 40 55 7\n9 7 2 1 100 10 20 30 40 55\n$EndElements");
+    mixed = replace_once(mixed, "3 2 2 7 1 10 20 30", "3 17 2 7 1 10 20 30 10 20 30 10 20 30 10 20 30 10 20 30 10 20 30 10 20");
+    edgefem::test::spit(p, mixed);
+    expect_mesh_error([&] { read_mesh(p); },
+                      {"mixed.msh:22:", "1 x prism (type 6), 1 x pyramid (type 7), 1 x 20-node hexahedron (type 17)"});
+    p = dir.file("unknown.msh");
+    edgefem::test::spit(p, replace_once(msh, "5 2 2 7 1 20 30 55", "5 200 2 7 1 20 30 55"));
+    expect_mesh_error([&] { read_mesh(p); }, {"unknown.msh:24:", "element type 200 is unknown"});
+    // MSH 4.1: the block's entity dimension says "volume" whatever the type.
+    const std::string msh41 = edgefem::test::slurp(data_file("small41.msh"));
+    p = dir.file("hex41.msh");
+    edgefem::test::spit(p, replace_once(msh41, "2 1 2 2\n", "3 1 5 2\n"));
+    expect_mesh_error([&] { read_mesh(p); }, {"hex41.msh:37:", "mesh has 2 x hexahedron (type 5)"});
+    p = dir.file("odd41.msh");
+    edgefem::test::spit(p, replace_once(msh41, "2 1 2 2\n", "3 1 300 2\n"));
+    expect_mesh_error([&] { read_mesh(p); }, {"odd41.msh:37:", "2 x element (type 300)"});
+    // MEDIT
+    const std::string medit = edgefem::test::slurp(data_file("small.mesh"));
+    p = dir.file("hex.mesh");
+    edgefem::test::spit(p, replace_once(medit, "End", "Hexahedra\n1\n1 2 3 4 5 6 1 2 0\nPrisms 1\n1 2 3 4 5 6 0\nEnd"));
+    expect_mesh_error([&] { read_mesh(p); },
+                      {"hex.mesh:30:", "mesh has 1 x Hexahedra, 1 x Prisms", "convert the mesh to tets"});
+}
+
 TEST(read_mesh_errors, MissingAndUnknownFiles) {
     expect_mesh_error([] { read_tetgen(data_file("no_such_mesh")); },
                       {"no_such_mesh.node", "cannot open"});
     expect_mesh_error([] { read_gmsh(data_file("no_such_mesh.msh")); }, {"no_such_mesh.msh"});
     expect_mesh_error([] { read_mesh(data_file("small.stl")); }, {"small.stl", "mesh format"});
     expect_mesh_error([] { read_mesh(data_file("x.meshb")); }, {"binary MEDIT"});
-    expect_mesh_error([] { read_medit(test::test_data_dir()); }, {"directory"});
+    expect_mesh_error([] { read_medit(test::test_data_dir()); }, {"is a directory, not a mesh file"});
+    // A device is never loaded: /dev/zero would be read until memory ran out.
+    expect_mesh_error([] { read_gmsh("/dev/zero"); }, {"/dev/zero: not a regular file"});
+    expect_mesh_error([] { read_tetgen("/dev/null"); }, {"/dev/null.node", "cannot open"});
 }
 
 TEST(read_mesh_errors, HandWrittenBadFiles) {
@@ -231,6 +327,13 @@ TEST(read_mesh_errors, EditedVariants) {
     expect_mesh_error([&] { read_medit(p); }, {"notmedit.mesh:1:", "MeshVersionFormatted"});
     p = write("trunc.mesh", medit.substr(0, medit.find("TETRAHEDRA") + 13));
     expect_mesh_error([&] { read_medit(p); }, {"trunc.mesh:", "truncated"});
+    // A skipped section's count too large or too small: the message names it.
+    p = write("skipbig.mesh", replace_once(medit, "triangles\n2\n", "triangles\n5\n"));
+    expect_mesh_error([&] { read_medit(p); },
+                      {"skipbig.mesh:25:", "while skipping section triangles (5 items)", "found keyword 'TETRAHEDRA'"});
+    p = write("skipsmall.mesh", replace_once(medit, "triangles\n2\n", "triangles\n1\n"));
+    expect_mesh_error([&] { read_medit(p); },
+                      {"skipsmall.mesh:24:", "expected a section keyword, got '2'", "section triangles"});
 
     // Vega
     p = write("range.veg", replace_once(veg, "2 2 3 4 5", "2 2 3 4 0"));
@@ -249,6 +352,14 @@ TEST(read_mesh_errors, EditedVariants) {
     expect_mesh_error([&] { read_tetgen(p); }, {"gap.node:5:", "consecutively", "expected 3, got 4"});
     p = tetgen("missing", replace_once(node, "3 0 0 0.1", "3 0 0"), ele);
     expect_mesh_error([&] { read_tetgen(p); }, {"missing.node:5:", "missing z coordinate"});
+    // In a file this small the byte-count check used to blame the count.
+    p = tetgen("tight", "5 3 0 0\n1 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n", "1 4\n1 1 2 3 4\n");
+    expect_mesh_error([&] { read_tetgen(p); }, {"tight.node:2:", "missing z coordinate"});
+    p = tetgen("tightattr", "2 3 1 0\n1 0 0 0\n2 1 0 0 5\n", "1 4\n1 1 2 3 4\n");
+    expect_mesh_error([&] { read_tetgen(p); }, {"tightattr.node:2:", "missing vertex attribute"});
+    // A count the remaining lines cannot hold is still blamed at once.
+    p = tetgen("count", "7 3 0 0\n1 0 0 0\n2 1 0 0\n", "1 4\n1 1 2 3 4\n");
+    expect_mesh_error([&] { read_tetgen(p); }, {"count.node:1:", "vertex count 7 is more than the rest of the file"});
     p = tetgen("attr", node, "3 4 1\n0 0 1 2 3   # no attribute here\n1 1 2 3 4 2\n2 0 2 1 5 1\n");
     expect_mesh_error([&] { read_tetgen(p); }, {"attr.ele:2:", "missing tet attribute"});
     p = tetgen("dim", replace_once(node, "6 3 0 0", "6 2 0 0"), ele);
@@ -268,6 +379,20 @@ TEST(read_mesh_errors, EditedVariants) {
                  std::to_string(kX[3 * i + 1]) + " " + std::to_string(kX[3 * i + 2]) + "\n";
     p = tetgen("base1", node1, ele);
     expect_mesh_error([&] { read_tetgen(p); }, {"base1.ele:2:", "tet 0", "vertex index 0", "1..6"});
+}
+
+TEST(read_mesh_errors, MessagesQuoteTheFilesVertexNumbers) {
+    edgefem::test::TempDir dir("readdup");
+    const std::string node = edgefem::test::slurp(data_file("small1.node"));
+    edgefem::test::spit(dir.file("dup.node"), node);
+    edgefem::test::spit(dir.file("dup.ele"), "4 4\n1 1 2 3 4\n2 2 3 4 5\n3 1 3 2 6\n4 2 1 4 3\n");
+    Mesh m = read_tetgen(dir.file("dup"));
+    // 1-based file: the vertices are quoted 1..6, not 0..5.
+    expect_mesh_error([&] { validate_mesh(m); }, {"duplicates tet 0", "(same vertices 2 1 4 3)"});
+    edgefem::test::spit(dir.file("twice.node"), node);
+    edgefem::test::spit(dir.file("twice.ele"), "1 4\n1 1 2 6 6\n");
+    Mesh t = read_tetgen(dir.file("twice"));
+    expect_mesh_error([&] { validate_mesh(t); }, {"uses vertex 6 twice"});
 }
 
 TEST(read_mesh, SharedMeshesTetGenAndGmshAgree) {

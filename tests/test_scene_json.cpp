@@ -377,6 +377,61 @@ TEST(SceneJsonErrors, Mesh) {
     EXPECT_NO_THROW(parse(R"({"mesh": ")" + data_file("bad/inverted") + R"(", "mesh_options": {"fix_orientation": true}})"));
 }
 
+TEST(SceneJsonErrors, DeepNestingIsRefusedNotRecursedInto) {
+    // json::dump recursed once per level: 100000 levels overflowed the stack.
+    const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+    expect_error(scene("\"gravity\": " + deep), {"scene.json", "invalid JSON", "nested deeper than 64 levels"});
+    // Within the limit, a deep or long value is described, not dumped.
+    const std::string msg = expect_error(scene("\"gravity\": " + std::string(60, '[') + std::string(60, ']')),
+                                         {"\"gravity\"", "3 numbers", "got an array of 1 value"});
+    EXPECT_EQ(msg.find("[["), std::string::npos) << msg;
+    std::string long_array = "[0";
+    for (int i = 0; i < 1000; ++i) long_array += ", 0";
+    expect_error(scene("\"gravity\": " + long_array + "]"), {"\"gravity\"", "got an array of 1001 values"});
+    expect_error(scene(R"("fixed": {"vertices": [0], "box": {}})"), {"\"fixed\"", "got {\"box\":{},\"vertices\":[0]}"});
+}
+
+TEST(SceneJsonErrors, IntegersPastInt64AreOutOfRange) {
+    // double(INT64_MAX) rounds up to 2^63: these used to pass the range check
+    // and wrap to vertex 0.
+    EXPECT_EQ(expect_error(scene(R"("fixed": {"vertices": [9223372036854775807]})"), {}),
+              "scene.json: \"fixed.vertices[0]\": vertex 9223372036854775807 out of range (mesh has 27 vertices)");
+    expect_error(scene(R"("fixed": {"vertices": [9.223372036854775807e18]})"), {"\"fixed.vertices[0]\"", "out of range (mesh has 27 vertices)"});
+    expect_error(scene(R"("fixed": {"vertices": [1e300]})"), {"\"fixed.vertices[0]\"", "out of range"});
+    expect_error(scene(R"("fixed": {"vertices": [18446744073709551615]})"), {"\"fixed.vertices[0]\"", "out of range"});
+    expect_error(scene(R"("fixed": {"vertices": [-9223372036854775808]})"), {"\"fixed.vertices[0]\"", "non-negative"});
+    expect_error(scene(R"("fixed": {"vertices": [-9.3e18]})"), {"\"fixed.vertices[0]\"", "non-negative"});
+    for (const char* big : {"9223372036854775807", "9.223372036854775807e18", "2147483648", "2147483648.0"})
+        expect_error(scene(std::string("\"steps\": ") + big), {"\"steps\"", "up to 2147483647"});
+    EXPECT_EQ(parse(scene(R"("steps": 2147483647)")).scene.steps, 2147483647);
+    expect_error(R"({"mesh": {"box": {"cells": [2, 9.3e18, 2]}}})", {"\"mesh.box.cells[1]\"", "up to 2147483647"});
+}
+
+TEST(SceneJsonErrors, NumberOverflowNamesTheFileAndPosition) {
+    const std::string msg = expect_error(scene(R"("gravity": [0, 0, 1e400])"),
+                                         {"scene.json: invalid JSON: number overflow parsing '1e400' at line 1, column 45"});
+    EXPECT_EQ(msg.find("[json.exception"), std::string::npos) << msg;
+    expect_error("{\"mesh\": \"box:2x2x2\",\n  \"dt\": -1e999}", {"scene.json", "'-1e999' at line 2, column 14"});
+}
+
+TEST(SceneJsonErrors, FilesMustBeRegular) {
+    TempDir dir("scene_regular");
+    // /dev/zero never ends: it used to be read until memory ran out.
+    expect_error(scene(R"("fixed": {"file": "/dev/zero"})"), {"\"fixed.file\"", "/dev/zero: not a regular file"});
+    expect_error(scene(R"("prescribed": {"file": "/dev/zero"})"), {"\"prescribed.file\"", "not a regular file"});
+    // A directory is named for what it should have been.
+    expect_error(scene(R"("fixed": {"file": "."})"), {"\"fixed.file\"", "is a directory, not a fixed-vertex file"}, dir.path());
+    expect_error(scene(R"("prescribed": {"file": "."})"), {"is a directory, not a prescribed-vertex file"}, dir.path());
+    for (const char* bad : {"/dev/zero", "/dev/null"}) {
+        try {
+            load_scene(bad);
+            ADD_FAILURE() << "no error for " << bad;
+        } catch (const InvalidArgument& e) {
+            EXPECT_EQ(std::string(e.what()), std::string(bad) + ": not a regular file");
+        }
+    }
+}
+
 TEST(SceneJsonErrors, BadJsonAndFiles) {
     const std::string msg = expect_error("{\"mesh\": \"box:2x2x2\",\n \"dt\": }", {"scene.json", "invalid JSON", "line 2"});
     EXPECT_EQ(msg.find("[json.exception"), std::string::npos) << msg;

@@ -1,7 +1,10 @@
 // Gmsh MSH 2.2 and 4.1 ASCII reader. Nodes keep file order and may have any
-// positive, non-contiguous tags; elements other than 4-node tets are skipped
-// and counted. Tets are resolved against the node tags once the whole file
-// is read, so section order does not matter.
+// positive, non-contiguous tags. 4-node tets are read; 10-node tets keep
+// their 4 corners (Gmsh lists the corners first). Other volume elements are
+// an error (simulating the tets alone would drop part of the body); point,
+// line and surface elements are boundary markup, skipped and counted. Tets
+// are resolved against the node tags once the whole file is read, so
+// section order does not matter.
 #include <algorithm>
 #include <limits>
 #include <map>
@@ -19,6 +22,22 @@ namespace edgefem {
 namespace {
 
 constexpr int kTetType = 4;
+constexpr int kTet10Type = 11;
+
+// Nodes of an element type read as a tet, or 0.
+int tet_node_count(std::int64_t type) { return type == kTetType ? 4 : type == kTet10Type ? 10 : 0; }
+
+// Dimension of an element type (Gmsh's GmshDefines.h), -1 when unknown.
+int element_dimension(std::int64_t type) {
+    static const std::map<std::int64_t, int> dims = {
+        {15, 0}, {1, 1},  {8, 1},  {26, 1}, {27, 1}, {28, 1}, {2, 2},  {3, 2},  {9, 2},
+        {10, 2}, {16, 2}, {20, 2}, {21, 2}, {22, 2}, {23, 2}, {24, 2}, {25, 2}, {4, 3},
+        {5, 3},  {6, 3},  {7, 3},  {11, 3}, {12, 3}, {13, 3}, {14, 3}, {17, 3}, {18, 3},
+        {19, 3}, {29, 3}, {30, 3}, {31, 3}, {32, 3}, {33, 3},
+    };
+    const auto it = dims.find(type);
+    return it == dims.end() ? -1 : it->second;
+}
 
 std::string element_type_name(std::int64_t type) {
     static const std::map<std::int64_t, const char*> names = {
@@ -56,6 +75,9 @@ struct GmshData {
     std::vector<std::int64_t> tet_entity;     // 4.1: entity tag of the tet's block
     std::unordered_map<std::int64_t, std::int64_t> volume_physical;  // 4.1 $Entities
     std::map<std::int64_t, std::int64_t> skipped;                      // type -> count
+    std::map<std::int64_t, std::int64_t> volume_skipped;               // type -> count: an error
+    std::int64_t first_volume_line = 0;                                // of the first volume element skipped
+    std::vector<std::pair<std::int64_t, std::size_t>> mid_nodes;       // 10-node tets: (tag, tet)
 };
 
 std::int64_t single_int(detail::TextReader& r, const std::string& what) {
@@ -97,15 +119,36 @@ void add_node(detail::TextReader& r, GmshData& d, std::int64_t tag, std::int64_t
     d.node_tag_line.push_back(tag_line);
 }
 
+// Reads the nodes of a 4- or 10-node tet; the mid-edge nodes of the latter
+// are only checked to exist (the corners come first).
 void add_tet(detail::TextReader& r, GmshData& d, std::int64_t tag, detail::LineTokens& tk,
-             int region, int entity_dim, std::int64_t entity) {
+             int nodes, int region, int entity_dim, std::int64_t entity) {
+    const std::size_t t = d.mesh.source.tet_id.size();
     for (int k = 0; k < 4; ++k) d.tet_nodes.push_back(r.next_int(tk, "tet node tag"));
-    r.expect_end(tk, "the 4 nodes of tetrahedron " + std::to_string(tag));
+    for (int k = 4; k < nodes; ++k) d.mid_nodes.emplace_back(r.next_int(tk, "tet node tag"), t);
+    r.expect_end(tk, "the " + std::to_string(nodes) + " nodes of tetrahedron " + std::to_string(tag));
     d.mesh.region.push_back(region);
     d.mesh.source.tet_line.push_back(r.line_no());
     d.mesh.source.tet_id.push_back(tag);
     d.tet_entity_dim.push_back(entity_dim);
     d.tet_entity.push_back(entity);
+}
+
+// Counts `count` skipped elements of `type`; volume elements are kept apart,
+// as they make the mesh unusable.
+void skip_elements(GmshData& d, std::int64_t type, int dim, std::int64_t count, std::int64_t line) {
+    const bool volume = dim == 3 || element_dimension(type) == 3;
+    if (volume && d.volume_skipped.empty()) d.first_volume_line = line;
+    (volume ? d.volume_skipped : d.skipped)[type] += count;
+}
+
+// "2 x triangle (type 2), 1 x line (type 1)".
+std::string summary(const std::map<std::int64_t, std::int64_t>& counts) {
+    std::string out;
+    for (const auto& [type, count] : counts)
+        out += (out.empty() ? "" : ", ") + std::to_string(count) + " x " + element_type_name(type) +
+               " (type " + std::to_string(type) + ")";
+    return out;
 }
 
 void read_nodes_22(detail::TextReader& r, GmshData& d) {
@@ -131,8 +174,13 @@ void read_elements_22(detail::TextReader& r, GmshData& d) {
         if (ntags < 0 || static_cast<std::size_t>(ntags) > tk.count())
             r.fail("bad number of tags " + std::to_string(ntags) + " for element " +
                    std::to_string(tag));
-        if (type != kTetType) {
-            ++d.skipped[type];
+        const int nodes = tet_node_count(type);
+        if (nodes == 0) {
+            // MSH 2.2 does not say an element's dimension; only the type does.
+            if (element_dimension(type) < 0)
+                r.fail("element type " + std::to_string(type) +
+                       " is unknown: cannot tell whether it is a volume element");
+            skip_elements(d, type, element_dimension(type), 1, r.line_no());
             continue;
         }
         std::int64_t physical = 0;
@@ -140,7 +188,7 @@ void read_elements_22(detail::TextReader& r, GmshData& d) {
             const std::int64_t value = r.next_int(tk, "element tag value");
             if (k == 0) physical = value;
         }
-        add_tet(r, d, tag, tk, region_from_tag(r, physical), 0, 0);
+        add_tet(r, d, tag, tk, nodes, region_from_tag(r, physical), 0, 0);
     }
     expect_line(r, "$EndElements", "after " + std::to_string(n) + " elements");
 }
@@ -234,15 +282,18 @@ void read_elements_41(detail::TextReader& r, GmshData& d) {
         if (total > n)
             r.fail("the element blocks hold more elements than the header's count " +
                    std::to_string(n));
+        const int nodes = tet_node_count(type);
         for (index_t i = 0; i < m; ++i) {
             r.require_line("element " + std::to_string(i + 1) + " of block " +
                            std::to_string(b + 1));
-            if (type != kTetType) continue;
+            if (nodes == 0) {
+                if (i == 0) skip_elements(d, type, static_cast<int>(dim), m, r.line_no());
+                continue;
+            }
             auto et = r.tokens();
             const std::int64_t tag = r.next_int(et, "element tag");
-            add_tet(r, d, tag, et, 0, static_cast<int>(dim), entity);
+            add_tet(r, d, tag, et, nodes, 0, static_cast<int>(dim), entity);
         }
-        if (type != kTetType) d.skipped[type] += m;
     }
     if (total != n)
         r.fail("the element blocks hold " + std::to_string(total) + " elements, the header says " +
@@ -350,6 +401,9 @@ Mesh read_gmsh(const std::string& path, ReadReport* report) {
     }
     if (!d.have_nodes) r.fail("no $Nodes section");
     if (!d.have_elements) r.fail("no $Elements section");
+    if (!d.volume_skipped.empty())
+        r.fail_at(d.first_volume_line, "mesh has " + summary(d.volume_skipped) +
+                                           ": edgefem simulates tets only; convert the mesh to tets");
 
     Mesh& mesh = d.mesh;
     auto& src = mesh.source;
@@ -380,13 +434,21 @@ Mesh read_gmsh(const std::string& path, ReadReport* report) {
         mesh.tets[i] = v;
     }
 
+    for (const auto& [tag, t] : d.mid_nodes)
+        if (map.find(tag) < 0)
+            r.fail_at(src.tet_line[t],
+                      detail::item_label("tet", static_cast<std::int64_t>(t), src.tet_id[t]) +
+                          ": node tag " + std::to_string(tag) + " is not defined in $Nodes",
+                      static_cast<std::int64_t>(t));
+
     if (report) {
-        for (const auto& [type, count] : d.skipped) {
-            report->skipped_elements += count;
-            if (!report->skipped_summary.empty()) report->skipped_summary += ", ";
-            report->skipped_summary += std::to_string(count) + " x " + element_type_name(type) +
-                                       " (type " + std::to_string(type) + ")";
-        }
+        for (const auto& [type, count] : d.skipped) report->skipped_elements += count;
+        if (!report->skipped_summary.empty() && !d.skipped.empty()) report->skipped_summary += ", ";
+        report->skipped_summary += summary(d.skipped);
+        if (!d.mid_nodes.empty())
+            report->warnings.push_back(
+                path + ": 10-node tets: kept the 4 corner nodes; the mid-edge nodes are left "
+                       "unreferenced (validate_mesh with compact_unreferenced removes them)");
     }
     return std::move(d.mesh);
 }

@@ -25,7 +25,8 @@ MeshFormat detect(const std::string& path) {
     if (ext == ".veg") return MeshFormat::Vega;
     if (ext == ".meshb") throw MeshError("binary MEDIT (.meshb) is not supported", path);
     std::error_code ec;
-    if (std::filesystem::exists(path + ".node", ec)) return MeshFormat::TetGen;
+    if (std::filesystem::exists(path + ".node", ec) || std::filesystem::exists(path + ".NODE", ec))
+        return MeshFormat::TetGen;
     throw MeshError(
         "cannot tell the mesh format: expected a .node/.ele (or their common prefix), .msh, "
         ".mesh or .veg file",

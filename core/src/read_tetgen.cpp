@@ -2,7 +2,10 @@
 // number in the .node file says (TetGen's own rule); the .ele file's vertex
 // indices use that base. Lines must hold exactly the values their header
 // declares, so a wrong header is caught instead of misread.
+#include <filesystem>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "edgefem/core/error.hpp"
@@ -13,8 +16,39 @@ namespace edgefem {
 
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+// Whether `s` ends with `suffix`, ignoring ASCII case (read_mesh detects the
+// format that way, so OK.NODE must read too).
+bool iends_with(const std::string& s, const std::string& suffix) {
+    return s.size() >= suffix.size() &&
+           detail::iequals(std::string_view(s).substr(s.size() - suffix.size()), suffix);
+}
+
+// prefix + ext ("ele"): upper-case when the file we were given is (OK.NODE
+// goes with OK.ELE), unless only the other case exists.
+std::string partner(const std::string& prefix, const std::string& ext, bool upper) {
+    const std::string preferred = prefix + "." + (upper ? detail::ascii_upper(ext) : ext);
+    const std::string other = prefix + "." + (upper ? ext : detail::ascii_upper(ext));
+    std::error_code ec;
+    if (!std::filesystem::exists(preferred, ec) && std::filesystem::exists(other, ec)) return other;
+    return preferred;
+}
+
+// The .node and .ele files of `path`: either file or their common prefix.
+std::pair<std::string, std::string> tetgen_files(const std::string& path) {
+    const auto upper = [&](std::size_t n) {
+        const std::string ext = path.substr(path.size() - n);
+        return ext == detail::ascii_upper(ext);
+    };
+    if (iends_with(path, ".node")) {
+        const std::string prefix = path.substr(0, path.size() - 5);
+        return {path, partner(prefix, "ele", upper(4))};
+    }
+    if (iends_with(path, ".ele")) {
+        const std::string prefix = path.substr(0, path.size() - 4);
+        return {partner(prefix, "node", upper(3)), path};
+    }
+    const std::string node = partner(path, "node", false);
+    return {node, partner(path, "ele", node.back() == 'E')};
 }
 
 // Checks an item number: the first sets the base (0 or 1), the others must
@@ -134,12 +168,10 @@ void read_ele_file(const std::string& file, std::int64_t base, Mesh& mesh, ReadR
 }  // namespace
 
 Mesh read_tetgen(const std::string& path, ReadReport* report) {
-    std::string prefix = path;
-    if (ends_with(path, ".node")) prefix.resize(path.size() - 5);
-    else if (ends_with(path, ".ele")) prefix.resize(path.size() - 4);
+    const auto [node, ele] = tetgen_files(path);
     Mesh mesh;
-    const std::int64_t base = read_node_file(prefix + ".node", mesh);
-    read_ele_file(prefix + ".ele", base, mesh, report);
+    const std::int64_t base = read_node_file(node, mesh);
+    read_ele_file(ele, base, mesh, report);
     return mesh;
 }
 

@@ -35,8 +35,25 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 std::string item(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
 
-// A value as it appears in the file, shortened for messages.
+// True when `v` holds at most `budget` values nested at most `depth` deep:
+// small enough to quote. The budget bounds both the work and the recursion.
+bool small_value(const json& v, int depth, int& budget) {
+    if (--budget < 0) return false;
+    if (!v.is_structured()) return true;
+    if (depth == 0) return false;
+    for (const json& e : v)
+        if (!small_value(e, depth - 1, budget)) return false;
+    return true;
+}
+
+// A value as it appears in the file, shortened for messages. Large or deep
+// containers are only described: json::dump recurses once per level.
 std::string show(const json& v) {
+    int budget = 32;
+    if (!small_value(v, 3, budget)) {
+        const std::string n = std::to_string(v.size()), s = v.size() == 1 ? "" : "s";
+        return v.is_array() ? "an array of " + n + " value" + s : "an object with " + n + " key" + s;
+    }
     std::string s = v.dump();
     if (s.size() > 60) s = s.substr(0, 57) + "...";
     return s;
@@ -95,25 +112,34 @@ double get_number(const Context& cx, const json& v, const std::string& path, Ran
     return x;
 }
 
-// Integers may be written as 1000 or 1e3, not as 2.5.
+// 2^63: the first double past int64 (double(INT64_MAX) rounds up to it).
+constexpr double kTwo63 = 9223372036854775808.0;
+
+// Integers may be written as 1000 or 1e3, not as 2.5. Ranges are compared as
+// integers: a double cannot hold every int64, so comparing doubles would let
+// INT64_MAX through and overflow the cast.
 std::int64_t get_integer(const Context& cx, const json& v, const std::string& path, std::int64_t min,
                          std::int64_t max = std::numeric_limits<int>::max()) {
     const std::string want = min == 0 ? "a non-negative integer" : min == 1 ? "a positive integer"
                                                                             : "an integer >= " + std::to_string(min);
-    double x = 0;
-    if (v.is_number_integer()) {
-        // Unsigned values above int64 cannot be stored; they are out of range anyway.
-        if (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(max)) cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v));
-        x = double(v.get<std::int64_t>());
+    const auto too_big = [&] { cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v)); };
+    std::int64_t i = 0;
+    if (v.is_number_unsigned()) {
+        if (v.get<std::uint64_t>() > std::uint64_t(max)) too_big();
+        i = std::int64_t(v.get<std::uint64_t>());
+    } else if (v.is_number_integer()) {
+        i = v.get<std::int64_t>();
     } else if (v.is_number_float()) {
-        x = v.get<double>();
-        if (!std::isfinite(x) || x != std::floor(x)) cx.fail(path, "expected " + want + ", got " + show(v));
+        const double x = v.get<double>();
+        if (!std::isfinite(x) || x != std::floor(x) || x < -kTwo63) cx.fail(path, "expected " + want + ", got " + show(v));
+        if (x >= kTwo63) too_big();
+        i = static_cast<std::int64_t>(x);
     } else {
         cx.fail(path, "expected " + want + ", got " + show(v));
     }
-    if (x < double(min)) cx.fail(path, "expected " + want + ", got " + show(v));
-    if (x > double(max)) cx.fail(path, "expected " + want + " up to " + std::to_string(max) + ", got " + show(v));
-    return static_cast<std::int64_t>(x);
+    if (i < min) cx.fail(path, "expected " + want + ", got " + show(v));
+    if (i > max) too_big();
+    return i;
 }
 
 int get_int(const Context& cx, const json& v, const std::string& path, int min) {
@@ -219,8 +245,21 @@ Renumbering compaction_map(const Mesh& read, bool compact) {
     return r;
 }
 
-std::string out_of_range(std::int64_t v, index_t count) {
-    return "vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(count) + " vertices)";
+std::string out_of_range(const std::string& v, index_t count) {
+    return "vertex " + v + " out of range (mesh has " + std::to_string(count) + " vertices)";
+}
+
+std::string out_of_range(std::int64_t v, index_t count) { return out_of_range(std::to_string(v), count); }
+
+// A vertex index of the mesh as read: any integer from `count` up is out of
+// range, including whole numbers past int64 written as floats (9.3e18).
+index_t get_vertex(const Context& cx, const json& v, const std::string& path, index_t count) {
+    const bool huge = (v.is_number_float() && v.get<double>() >= kTwo63) ||
+                      (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<std::int64_t>::max()));
+    if (huge) cx.fail(path, out_of_range(show(v), count));
+    const std::int64_t i = get_integer(cx, v, path, 0, std::numeric_limits<std::int64_t>::max());
+    if (i >= count) cx.fail(path, out_of_range(i, count));
+    return index_t(i);
 }
 
 // One parsed line of a fixed (index) or prescribed (index x y z) file.
@@ -238,7 +277,7 @@ std::vector<IndexLine> read_index_file(const Context& cx, const std::string& key
     const char* what = coords ? "'index x y z'" : "a vertex index";
     std::vector<IndexLine> out;
     try {
-        detail::TextReader r(path, '#');
+        detail::TextReader r(path, '#', coords ? "prescribed-vertex file" : "fixed-vertex file");
         while (r.next_line()) {
             auto tok = r.tokens();
             IndexLine l{};
@@ -288,9 +327,7 @@ void add_fixed(const Context& cx, const json& sel, const std::string& path, cons
         const std::string key = join(path, "vertices");
         if (!vs->is_array() || vs->empty()) cx.fail(key, "expected a non-empty array of vertex indices, got " + show(*vs));
         for (std::size_t i = 0; i < vs->size(); ++i) {
-            const std::int64_t v = get_integer(cx, (*vs)[i], item(key, i), 0, std::numeric_limits<std::int64_t>::max());
-            if (v >= renumber.read_count) cx.fail(item(key, i), out_of_range(v, renumber.read_count));
-            add(index_t(v));
+            add(get_vertex(cx, (*vs)[i], item(key, i), renumber.read_count));
         }
     } else {
         const json& box = sel["box"];
@@ -455,19 +492,87 @@ SceneFile parse(const Context& cx, const json& root) {
     return sf;
 }
 
+// ---- JSON text -------------------------------------------------------------
+
+// Far deeper than any scene needs; deeper input is refused at parse time so
+// that nothing later has to guard against deep recursion.
+constexpr int kMaxDepth = 64;
+
+// json::parse's DOM builder behind SAX events, so that nesting can be capped
+// and every failure keeps its byte offset (nlohmann's number-overflow
+// message has no position).
+class CappedDomBuilder {
+public:
+    explicit CappedDomBuilder(json& root) : dom_(root, /*allow_exceptions=*/false) {}
+
+    bool null() { return dom_.null(); }
+    bool boolean(bool v) { return dom_.boolean(v); }
+    bool number_integer(json::number_integer_t v) { return dom_.number_integer(v); }
+    bool number_unsigned(json::number_unsigned_t v) { return dom_.number_unsigned(v); }
+    bool number_float(json::number_float_t v, const std::string& s) { return dom_.number_float(v, s); }
+    bool string(json::string_t& v) { return dom_.string(v); }
+    bool binary(json::binary_t& v) { return dom_.binary(v); }
+    bool key(json::string_t& v) { return dom_.key(v); }
+    bool start_object(std::size_t n) { return enter() && dom_.start_object(n); }
+    bool start_array(std::size_t n) { return enter() && dom_.start_array(n); }
+    bool end_object() { --depth_; return dom_.end_object(); }
+    bool end_array() { --depth_; return dom_.end_array(); }
+    template <class Exception>
+    bool parse_error(std::size_t offset, const std::string& /*token*/, const Exception& e) {
+        offset_ = offset;
+        message_ = e.what();
+        return false;
+    }
+
+    bool too_deep() const { return too_deep_; }
+    std::size_t offset() const { return offset_; }
+    const std::string& message() const { return message_; }
+
+private:
+    bool enter() {
+        too_deep_ = ++depth_ > kMaxDepth;
+        return !too_deep_;
+    }
+
+    nlohmann::detail::json_sax_dom_parser<json> dom_;
+    int depth_ = 0;
+    bool too_deep_ = false;
+    std::size_t offset_ = 0;
+    std::string message_;
+};
+
+// " at line L, column C" of a byte offset into `text`, counted as nlohmann does.
+std::string position(const std::string& text, std::size_t offset) {
+    offset = std::min(offset, text.size());
+    std::size_t line = 1, line_start = 0;
+    for (std::size_t i = 0; i < offset; ++i)
+        if (text[i] == '\n') {
+            ++line;
+            line_start = i + 1;
+        }
+    return " at line " + std::to_string(line) + ", column " + std::to_string(offset - line_start);
+}
+
+json parse_json(const std::string& text, const std::string& source) {
+    json root;
+    CappedDomBuilder sax(root);
+    if (json::sax_parse(text, &sax, json::input_format_t::json, /*strict=*/true, /*ignore_comments=*/true))
+        return root;
+    if (sax.too_deep())
+        throw InvalidArgument(source + ": invalid JSON: nested deeper than " + std::to_string(kMaxDepth) + " levels");
+    // Drop nlohmann's "[json.exception.parse_error.101] " tag; its parse
+    // errors say where they are, its other errors do not.
+    std::string what = sax.message();
+    if (const auto p = what.find("] "); what.rfind("[json.exception", 0) == 0 && p != std::string::npos) what.erase(0, p + 2);
+    if (what.find(" at line ") == std::string::npos) what += position(text, sax.offset());
+    throw InvalidArgument(source + ": invalid JSON: " + what);
+}
+
 }  // namespace
 
 SceneFile parse_scene(const std::string& text, const std::string& base_dir, const std::string& source_name) {
     const Context cx{source_name, base_dir};
-    json root;
-    try {
-        root = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-    } catch (const json::parse_error& e) {
-        // Drop nlohmann's "[json.exception.parse_error.101] " tag.
-        std::string what = e.what();
-        if (const auto p = what.find("] "); what.rfind("[json.exception", 0) == 0 && p != std::string::npos) what.erase(0, p + 2);
-        throw InvalidArgument(source_name + ": invalid JSON: " + what);
-    }
+    const json root = parse_json(text, source_name);
     SceneFile sf = parse(cx, root);
     sf.path = source_name;
     return sf;
@@ -475,7 +580,10 @@ SceneFile parse_scene(const std::string& text, const std::string& base_dir, cons
 
 SceneFile load_scene(const std::string& path) {
     std::error_code ec;
-    if (fs::is_directory(path, ec)) throw InvalidArgument(path + ": is a directory, not a scene file");
+    const auto status = fs::status(path, ec);
+    if (fs::is_directory(status)) throw InvalidArgument(path + ": is a directory, not a scene file");
+    // A device or a pipe (/dev/zero) may never end; the whole file is loaded.
+    if (fs::exists(status) && !fs::is_regular_file(status)) throw InvalidArgument(path + ": not a regular file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InvalidArgument(path + ": cannot open scene file");
     std::ostringstream text;

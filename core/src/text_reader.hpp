@@ -32,8 +32,9 @@ class TextReader {
 public:
     // Loads `path`; `comment` starts a comment running to the end of the line
     // ('\0': the format has no comments). Throws MeshError when the file
-    // cannot be read.
-    TextReader(std::string path, char comment);
+    // cannot be read or is not a regular file; `kind` names what the file
+    // should be ("mesh file") in those messages.
+    TextReader(std::string path, char comment, const std::string& kind = "mesh file");
 
     const std::string& path() const { return path_; }
     bool file_empty() const { return data_.empty(); }
@@ -68,11 +69,19 @@ public:
 
     // Validates a count read from a header before anything is allocated for
     // it: it must be non-negative, fit index_t, and the rest of the file must
-    // be long enough for `count` items of at least `min_tokens` tokens each
-    // (so a corrupt count cannot make us reserve gigabytes).
+    // be long enough for `count` items of at least `min_tokens` tokens each,
+    // or at least hold `count` more lines (then a short item line is left
+    // for the item parser to report). A corrupt count cannot make us reserve
+    // more than the file's size in items.
     index_t check_count(std::int64_t count, int min_tokens, const std::string& what) const;
 
 private:
+    // The next non-blank line (comment stripped) at or after `pos`, moving
+    // `pos` and `line_no` past it; false at the end of the file.
+    bool scan(std::size_t& pos, std::int64_t& line_no, std::string_view& line) const;
+    // Whether `n` more non-blank lines follow the current one.
+    bool has_lines(std::int64_t n) const;
+
     std::string path_;
     std::string data_;
     std::size_t pos_ = 0;

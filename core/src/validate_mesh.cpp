@@ -27,6 +27,13 @@ std::string num(double x) {
 
 const double* vertex(const Mesh& m, index_t v) { return &m.X[3 * static_cast<std::size_t>(v)]; }
 
+// Vertex v as the file numbers it (a message quoting a tet's vertices must
+// match what the user sees in the file: TetGen may start at 1, Gmsh tags).
+std::string file_vertex(const Mesh& m, index_t v) {
+    const auto& id = m.source.vertex_id;
+    return std::to_string(static_cast<std::size_t>(v) < id.size() ? id[v] : v);
+}
+
 void check_structure(const Mesh& mesh) {
     const auto& src = mesh.source;
     if (mesh.X.size() % 3 != 0)
@@ -57,7 +64,7 @@ void check_indices(const Mesh& mesh) {
             for (int j = 0; j < k; ++j)
                 if (tet[j] == tet[k])
                     throw MeshError(mesh.describe_tet(t) + " is degenerate: it uses vertex " +
-                                        std::to_string(tet[k]) + " twice",
+                                        file_vertex(mesh, tet[k]) + " twice",
                                     {}, 0, t);
         }
     }
@@ -116,8 +123,8 @@ void check_duplicates(const Mesh& mesh) {
     if (count == 0) return;
     const index_t* tet = &mesh.tets[4 * static_cast<std::size_t>(first_b)];
     std::string msg = mesh.describe_tet(first_b) + " duplicates " + mesh.describe_tet(first_a) +
-                      " (same vertices " + std::to_string(tet[0]) + " " + std::to_string(tet[1]) +
-                      " " + std::to_string(tet[2]) + " " + std::to_string(tet[3]) + ")";
+                      " (same vertices " + file_vertex(mesh, tet[0]) + " " + file_vertex(mesh, tet[1]) +
+                      " " + file_vertex(mesh, tet[2]) + " " + file_vertex(mesh, tet[3]) + ")";
     if (count > 1) msg += "; " + std::to_string(count) + " duplicate tets in all";
     throw MeshError(msg, {}, 0, first_b);
 }

@@ -16,23 +16,30 @@ enum class MeshFormat { Auto, TetGen, Gmsh, Medit, Vega };
 
 // What a reader skipped or noticed without failing.
 struct ReadReport {
-    std::int64_t skipped_elements = 0;  // non-tet elements skipped (Gmsh, MEDIT, Vega)
+    std::int64_t skipped_elements = 0;  // point, line and surface elements skipped (Gmsh, MEDIT)
     std::string skipped_summary;        // e.g. "2 x triangle, 14 x line"
     std::vector<std::string> warnings;
 };
 
-// TetGen .node/.ele: `path` is the .node file, the .ele file or their common
-// prefix. 0- or 1-based numbering, '#' comments, attributes and boundary
-// markers are accepted; the first tet attribute, if any, becomes the region.
+// Every reader keeps the 4 corners of 10-node (quadratic) tets, whose
+// mid-edge nodes are left unreferenced, and fails on any other volume element
+// (hexahedra, prisms, pyramids, ...): simulating the tets alone would drop
+// part of the body. Point, line and surface elements are boundary markup:
+// they are skipped and counted in ReadReport.
+
+// TetGen .node/.ele: `path` is the .node file, the .ele file (extensions in
+// either case) or their common prefix. 0- or 1-based numbering, '#' comments,
+// attributes and boundary markers are accepted; the first tet attribute, if
+// any, becomes the region.
 Mesh read_tetgen(const std::string& path, ReadReport* report = nullptr);
-// Gmsh MSH 2.2 and 4.1 ASCII; tetrahedra (type 4) are kept, other element
-// types are skipped and counted; the physical tag becomes the region.
+// Gmsh MSH 2.2 and 4.1 ASCII: tetrahedra (types 4 and 11); the physical tag
+// becomes the region.
 Mesh read_gmsh(const std::string& path, ReadReport* report = nullptr);
-// MEDIT .mesh (ASCII): Vertices and Tetrahedra sections; the tet reference
-// becomes the region; other sections are skipped.
+// MEDIT .mesh (ASCII): Vertices, Tetrahedra and TetrahedraP2 sections; the
+// tet reference becomes the region; other sections are skipped.
 Mesh read_medit(const std::string& path, ReadReport* report = nullptr);
 // Vega .veg: *VERTICES and *ELEMENTS (TET) sections, 1-based; material
-// sections are skipped.
+// sections are skipped and other element types refused.
 Mesh read_vega(const std::string& path, ReadReport* report = nullptr);
 
 // Chooses the reader from the extension (.node/.ele or an existing prefix,
