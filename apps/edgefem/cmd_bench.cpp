@@ -274,19 +274,14 @@ void add_bench_command(CLI::App& app) {
                     "With --stream: alternate the timed calls (--seconds split evenly) and STREAM (median of 3) this "
                     "many times; fraction_of_stream_paired is the median over the rounds of each round's median call "
                     "against the triad measured right after it")
-        ->check(CLI::PositiveNumber)
+        ->check(int_in_range(1, 1000))
         ->needs(stream_flag)
         ->capture_default_str();
     cmd->add_option("--cg-iters", opts->cg_iters,
                     "step: run exactly N warm-started CG iterations per step instead of solving to 1e-6")
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--seconds", opts->seconds, "Time budget of the timed calls")
-        ->check(CLI::Validator(
-            [](std::string& s) {
-                double v = 0;
-                return CLI::detail::lexical_cast(s, v) && v > 0 ? std::string() : "must be a positive number, got " + s;
-            },
-            "POSITIVE"))
+        ->check(int_in_range(1));
+    cmd->add_option("--seconds", opts->seconds, "Time budget of the timed calls, at most 3600")
+        ->check(seconds_at_most(3600))
         ->capture_default_str();
     cmd->callback([opts] { run_bench(*opts); });
 }

@@ -185,7 +185,7 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md); default: the built-in beam");
     cmd->add_option("--out", opts->out, "Output folder (overrides the scene's output.dir; default edgefem-out)");
     cmd->add_option("--steps", opts->steps, "Number of steps (overrides the scene's steps)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(int_in_range(0));
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
     add_exec_options(*cmd, opts->exec);

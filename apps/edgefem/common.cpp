@@ -133,7 +133,7 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
         ->check(CLI::IsMember({"serial", "omp", "tbb"}))
         ->capture_default_str();
     cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb back-end (0: all hardware threads)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(int_in_range(0))
         ->capture_default_str();
     cmd.add_option("--schedule", opts.schedule,
                    "How the omp/tbb back-end hands the kernels' chunks to threads: dynamic (balances uneven "

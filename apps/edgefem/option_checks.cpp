@@ -1,0 +1,48 @@
+#include "option_checks.hpp"
+
+#include <charconv>
+#include <cstdio>
+
+namespace edgefem::cli {
+
+namespace {
+
+std::string g6(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+}  // namespace
+
+CLI::Validator int_in_range(long long min, long long max) {
+    const bool bounded = max != std::numeric_limits<long long>::max();
+    const std::string want = bounded ? "expected an integer from " + std::to_string(min) + " to " + std::to_string(max)
+                                     : "expected an integer >= " + std::to_string(min);
+    return CLI::Validator(
+        [min, max, want](std::string& s) {
+            long long v = 0;
+            const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+            if (ec != std::errc() || end != s.data() + s.size() || v < min || v > max)
+                return want + ", got '" + s + "'";
+            return std::string();
+        },
+        bounded ? "INT in [" + std::to_string(min) + ", " + std::to_string(max) + "]"
+                : "INT >= " + std::to_string(min));
+}
+
+CLI::Validator seconds_at_most(double max) {
+    const std::string want = "expected a number of seconds > 0 and <= " + g6(max);
+    return CLI::Validator(
+        [max, want](std::string& s) {
+            double v = 0;
+            const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+            // !(v <= max) also catches NaN.
+            if (ec != std::errc() || end != s.data() + s.size() || !(v > 0) || !(v <= max))
+                return want + ", got '" + s + "'";
+            return std::string();
+        },
+        "SECONDS in (0, " + g6(max) + "]");
+}
+
+}  // namespace edgefem::cli

@@ -1,0 +1,18 @@
+// Checks of command-line values shared by the edgefem subcommands.
+#pragma once
+
+#include <limits>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace edgefem::cli {
+
+// CLI11's Range/PositiveNumber/NonNegativeNumber print DBL_MAX in full and
+// even reject values inside the range they print; these name the bound.
+// CLI11 prefixes the option's name: "--cg-iters: expected an integer >= 1, got '0'".
+CLI::Validator int_in_range(long long min, long long max = std::numeric_limits<long long>::max());
+// A finite number of seconds in (0, max]: inf or 1e300 would never end or
+// overflow a step count.
+CLI::Validator seconds_at_most(double max);
+}  // namespace edgefem::cli
