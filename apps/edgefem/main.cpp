@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
     edgefem::cli::add_accuracy_command(app);
     edgefem::cli::add_bench_layouts_command(app);
     // CLI11 would report a mistyped subcommand as "A subcommand is required".
+    edgefem::cli::reject_empty_numbers(app);
     if (argc > 1 && argv[1][0] != '-') {
         bool known = false;
         for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))

@@ -45,4 +45,17 @@ CLI::Validator seconds_at_most(double max) {
         "SECONDS in (0, " + g6(max) + "]");
 }
 
+void reject_empty_numbers(CLI::App& app) {
+    for (CLI::Option* opt : app.get_options()) {
+        // The type name is followed by the checks' names ("INT:INT >= 0").
+        const std::string full = opt->get_type_name(), type = full.substr(0, full.find(':'));
+        if (type == "INT" || type == "UINT" || type == "FLOAT" || type == "NUMBER")
+            // transform() puts the check first, ahead of range checks that
+            // would complain about "" in their own words.
+            opt->transform(CLI::Validator(
+                [](std::string& s) { return s.empty() ? std::string("empty value") : std::string(); }, ""));
+    }
+    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) reject_empty_numbers(*sub);
+}
+
 }  // namespace edgefem::cli

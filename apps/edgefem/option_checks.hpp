@@ -15,4 +15,8 @@ CLI::Validator int_in_range(long long min, long long max = std::numeric_limits<l
 // A finite number of seconds in (0, max]: inf or 1e300 would never end or
 // overflow a step count.
 CLI::Validator seconds_at_most(double max);
+// Adds to every numeric option of `app` and its subcommands, ahead of its
+// other checks, a check that rejects an empty value ("--poisson: empty
+// value"): CLI11 would convert "" to 0. Call after adding the subcommands.
+void reject_empty_numbers(CLI::App& app);
 }  // namespace edgefem::cli
