@@ -75,12 +75,16 @@ void add_forces_command(CLI::App& app) {
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/true);
     add_exec_options(*cmd, opts->exec);
-    auto* pos = cmd->add_option("--pos", opts->pos, "Current positions: one 'x y z' line per vertex (default: rest shape)");
-    cmd->add_option("--dir", opts->dir, "Direction vector, one 'x y z' line per vertex: also write PREFIX.Kdir = K dir");
+    // Empty paths would be taken as "not given" (--pos, --dir) or write
+    // hidden files (--out "": .energy, .force).
+    auto* pos = cmd->add_option("--pos", opts->pos, "Current positions: one 'x y z' line per vertex (default: rest shape)")
+                    ->check(non_empty_path());
+    cmd->add_option("--dir", opts->dir, "Direction vector, one 'x y z' line per vertex: also write PREFIX.Kdir = K dir")
+        ->check(non_empty_path());
     cmd->add_option("--deform", opts->deform, "Generate the configuration instead of --pos (also writes PREFIX.pos)")
         ->check(CLI::IsMember({"twist", "rotate", "random", "affine"}))
         ->excludes(pos);
-    cmd->add_option("--out", opts->out, "Output file prefix")->required();
+    cmd->add_option("--out", opts->out, "Output file prefix")->required()->check(non_empty_path());
     cmd->callback([opts] { run_forces(*opts); });
 }
 

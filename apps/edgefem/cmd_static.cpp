@@ -57,8 +57,9 @@ void add_static_command(CLI::App& app) {
         "Static equilibrium of a scene (docs/scenes.md) under gravity and its prescribed targets, by Newton "
         "with line search and automatic load stepping; writes PREFIX.disp (one 'ux uy uz' line per vertex, "
         "%.17g) and PREFIX.vtu");
-    cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md)")->required();
-    cmd->add_option("--out", opts->out, "Output file prefix")->required();
+    // An empty SCENE would mean the built-in beam (load_scene_file).
+    cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md)")->required()->check(non_empty_path());
+    cmd->add_option("--out", opts->out, "Output file prefix")->required()->check(non_empty_path());
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
     add_exec_options(*cmd, opts->exec);

@@ -29,7 +29,7 @@ void add_stress_command(CLI::App& app) {
         ->check(seconds_at_most(3600))
         ->capture_default_str();
     cmd->add_option("--filter", opts->filter, "Run only cases whose 'group name integrator' contains this text");
-    cmd->add_option("--json", opts->json, "Also write the results as JSON to this file");
+    cmd->add_option("--json", opts->json, "Also write the results as JSON to this file")->check(non_empty_path());
     cmd->footer(
         "Verdicts: pass (finite, energy of the free phase <= 2x its value at release, recovered to within\n"
         "1e-3 of the body size where required); failed cleanly (a SimulationError: acceptable; '(!)' marks\n"

@@ -27,7 +27,8 @@ void add_mesh_options(CLI::App& cmd, MeshOptions& opts) {
                    "Mesh: a TetGen .node or .ele file or their common prefix, a Gmsh .msh, MEDIT .mesh "
                    "or Vega .veg file, or the built-in box:NXxNYxNZ (NX x NY x NZ cubes of 0.01 m, "
                    "6 tets each; box:10x5x4 is the paper's 1,200-tet box)")
-        ->required();
+        ->required()
+        ->check(non_empty_path());
     cmd.add_flag("--fix-orientation", opts.fix_orientation,
                  "Reorient negatively oriented tets instead of rejecting the mesh");
     cmd.add_flag("--compact", opts.compact, "Remove vertices that no tet uses");

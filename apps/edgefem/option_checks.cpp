@@ -45,6 +45,11 @@ CLI::Validator seconds_at_most(double max) {
         "SECONDS in (0, " + g6(max) + "]");
 }
 
+CLI::Validator non_empty_path() {
+    return CLI::Validator([](std::string& s) { return s.empty() ? std::string("empty path") : std::string(); },
+                          "");
+}
+
 void reject_empty_numbers(CLI::App& app) {
     for (CLI::Option* opt : app.get_options()) {
         // The type name is followed by the checks' names ("INT:INT >= 0").

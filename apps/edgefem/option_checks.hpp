@@ -15,6 +15,9 @@ CLI::Validator int_in_range(long long min, long long max = std::numeric_limits<l
 // A finite number of seconds in (0, max]: inf or 1e300 would never end or
 // overflow a step count.
 CLI::Validator seconds_at_most(double max);
+// A path that is not the empty string ("" would silently mean a default or a
+// hidden file).
+CLI::Validator non_empty_path();
 // Adds to every numeric option of `app` and its subcommands, ahead of its
 // other checks, a check that rejects an empty value ("--poisson: empty
 // value"): CLI11 would convert "" to 0. Call after adding the subcommands.
