@@ -398,6 +398,8 @@ void add_accuracy_command(CLI::App& app) {
                     "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)")
         ->check(non_empty_path());
     cmd->callback([opts] {
+        // Before the runs, not after them: a typo in the path would lose them.
+        if (!opts->json.empty()) check_writable("--json", opts->json);
         const std::string cache = opts->cache.empty() ? default_cache_dir() : opts->cache;
         std::filesystem::create_directories(cache);
         const std::string mesh_folder = opts->mesh_dir.empty() ? mesh_dir(default_mesh_dir()) : opts->mesh_dir;

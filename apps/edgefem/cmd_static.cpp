@@ -21,6 +21,10 @@ struct StaticOptions {
 
 void run_static(const StaticOptions& opts) {
     const auto t0 = std::chrono::steady_clock::now();
+    // The files are written after the solve (minutes on a large mesh): a
+    // typo in the folder should not cost the solve.
+    check_writable("--out", opts.out + ".disp");
+    check_writable("--out", opts.out + ".vtu");
     SceneFile sf = load_scene_file(opts.scene);
     const auto executor = opts.exec.executor();
     OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.ordering), executor,

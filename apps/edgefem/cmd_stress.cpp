@@ -36,6 +36,8 @@ void add_stress_command(CLI::App& app) {
         "one against the a-priori expectation); FAIL (silent garbage or no recovery: a bug).\n"
         "Exit codes: 0 no FAIL, 2 bad input, 3 at least one FAIL.");
     cmd->callback([opts] {
+        // Before the suite, not after it: a typo in the path would lose the run.
+        if (!opts->json.empty()) check_writable("--json", opts->json);
         StressOptions so;
         so.quick = opts->quick;
         so.seconds = opts->seconds;

@@ -1,7 +1,14 @@
 #include "option_checks.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "edgefem/core/error.hpp"
 
 namespace edgefem::cli {
 
@@ -61,6 +68,25 @@ void reject_empty_numbers(CLI::App& app) {
                 [](std::string& s) { return s.empty() ? std::string("empty value") : std::string(); }, ""));
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) reject_empty_numbers(*sub);
+}
+
+void check_writable(const std::string& option, const std::string& path) {
+    namespace fs = std::filesystem;
+    if (path.empty()) throw InvalidArgument(option + ": empty path");
+    std::error_code ec;
+    const fs::path p(path);
+    if (fs::is_directory(p, ec)) throw InvalidArgument(option + ": " + path + " is a folder, not a file");
+    if (fs::exists(p, ec)) {
+        if (::access(path.c_str(), W_OK) != 0)
+            throw InvalidArgument(option + ": cannot write " + path + ": " + std::strerror(errno));
+        return;
+    }
+    const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+    if (!fs::is_directory(dir, ec))
+        throw InvalidArgument(option + ": cannot write " + path + ": no folder " + dir.string());
+    if (::access(dir.c_str(), W_OK) != 0)
+        throw InvalidArgument(option + ": cannot write " + path + ": folder " + dir.string() + ": " +
+                              std::strerror(errno));
 }
 
 }  // namespace edgefem::cli

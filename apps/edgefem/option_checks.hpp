@@ -22,4 +22,10 @@ CLI::Validator non_empty_path();
 // other checks, a check that rejects an empty value ("--poisson: empty
 // value"): CLI11 would convert "" to 0. Call after adding the subcommands.
 void reject_empty_numbers(CLI::App& app);
+
+// Throws Error naming `option` when `path` cannot be created or written (its
+// folder is missing or not writable, or it is a folder): checked before a long
+// run, so that the run is not lost to a typo. Creates nothing.
+void check_writable(const std::string& option, const std::string& path);
+
 }  // namespace edgefem::cli
