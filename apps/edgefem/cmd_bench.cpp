@@ -150,6 +150,7 @@ void run_bench(const BenchOptions& opts) {
     if (opts.stream && opts.kernel == "step") throw InvalidArgument("--stream does not apply to --kernel step");
     if (opts.cg_iters > 0 && opts.kernel != "step") throw InvalidArgument("--cg-iters applies only to --kernel step");
     LoadedMesh lm = load_mesh(opts.mesh);
+    check_mesh_scale(lm.mesh, opts.model.precision_kind(), opts.mesh.path);
     for (const auto& w : load_warnings(lm)) std::fprintf(stderr, "edgefem: warning: %s\n", w.c_str());
     if (opts.kernel == "step") {
         if (opts.model.precision_kind() == Precision::Float)
