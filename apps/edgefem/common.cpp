@@ -27,7 +27,7 @@ void add_mesh_options(CLI::App& cmd, MeshOptions& opts) {
     cmd.add_option("MESH", opts.path,
                    "Mesh: a TetGen .node or .ele file or their common prefix, a Gmsh .msh, MEDIT .mesh "
                    "or Vega .veg file, or the built-in box:NXxNYxNZ (NX x NY x NZ cubes of 0.01 m, "
-                   "6 tets each; box:10x5x4 is the paper's 1,200-tet box)")
+                   "6 tets each, at most 2^28 tets; box:10x5x4 is the paper's 1,200-tet box)")
         ->required()
         ->check(non_empty_path());
     cmd.add_flag("--fix-orientation", opts.fix_orientation,
