@@ -151,6 +151,14 @@ void run_bench(const BenchOptions& opts) {
     if (opts.cg_iters > 0 && opts.kernel != "step") throw InvalidArgument("--cg-iters applies only to --kernel step");
     LoadedMesh lm = load_mesh(opts.mesh);
     check_mesh_scale(lm.mesh, opts.model.precision_kind(), opts.mesh.path);
+    // The step's scene gives every vertex mass from its tets; without this
+    // check the scene's own "vertex 5 has no mass" names a scene the user
+    // never wrote. Before the warnings, so that the error is the one line.
+    if (const index_t n = lm.validation.unreferenced_vertices - lm.validation.removed_vertices;
+        opts.kernel == "step" && n > 0)
+        throw InvalidArgument(opts.mesh.path + ": the mesh has unreferenced vertices (" + std::to_string(n) +
+                              " that no tet uses, so they would have no mass in --kernel step): pass "
+                              "--compact to remove them");
     for (const auto& w : load_warnings(lm)) std::fprintf(stderr, "edgefem: warning: %s\n", w.c_str());
     if (opts.kernel == "step") {
         if (opts.model.precision_kind() == Precision::Float)
