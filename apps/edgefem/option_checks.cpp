@@ -34,8 +34,11 @@ CLI::Validator int_in_range(long long min, long long max) {
                 return want + ", got '" + s + "'";
             return std::string();
         },
-        bounded ? "INT in [" + std::to_string(min) + ", " + std::to_string(max) + "]"
-                : "INT >= " + std::to_string(min));
+        // The name --help shows after the type ("INT:POSITIVE").
+        bounded    ? "[" + std::to_string(min) + " - " + std::to_string(max) + "]"
+        : min == 0 ? "NONNEGATIVE"
+        : min == 1 ? "POSITIVE"
+                   : ">= " + std::to_string(min));
 }
 
 CLI::Validator seconds_at_most(double max) {
@@ -49,7 +52,7 @@ CLI::Validator seconds_at_most(double max) {
                 return want + ", got '" + s + "'";
             return std::string();
         },
-        "SECONDS in (0, " + g6(max) + "]");
+        "POSITIVE <= " + g6(max));
 }
 
 CLI::Validator non_empty_path() {
@@ -59,7 +62,7 @@ CLI::Validator non_empty_path() {
 
 void reject_empty_numbers(CLI::App& app) {
     for (CLI::Option* opt : app.get_options()) {
-        // The type name is followed by the checks' names ("INT:INT >= 0").
+        // The type name is followed by the checks' names ("INT:NONNEGATIVE").
         const std::string full = opt->get_type_name(), type = full.substr(0, full.find(':'));
         if (type == "INT" || type == "UINT" || type == "FLOAT" || type == "NUMBER")
             // transform() puts the check first, ahead of range checks that
