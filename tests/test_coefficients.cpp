@@ -97,5 +97,12 @@ TEST(MakeBox, SizesOrientationAndBadArguments) {
     EXPECT_THROW(make_box(0, 1, 1), InvalidArgument);
     EXPECT_THROW(make_box(1, 1, 1, -0.01), InvalidArgument);
     EXPECT_THROW(make_box(2000, 2000, 2000), InvalidArgument);  // 4.8e10 tets: beyond 32-bit indices
+    // 2.1e9 tets, under 2^31 but past kMaxBoxTets: refused before allocating.
+    EXPECT_THROW(make_box(1000, 1000, 350), InvalidArgument);
+    try {
+        make_box(1000, 1000, 350);
+    } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("268435456"), std::string::npos) << e.what();
+    }
     EXPECT_NEAR(make_box_of_size(50000).num_tets(), 50000, 0.1 * 50000);
 }

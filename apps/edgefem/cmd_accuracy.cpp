@@ -38,6 +38,7 @@
 #include "edgefem/core/named_mesh.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/validate_mesh.hpp"
+#include "option_checks.hpp"
 #include "evidence_commands.hpp"
 
 namespace edgefem::cli {
@@ -389,12 +390,16 @@ void add_accuracy_command(CLI::App& app) {
     auto opts = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("accuracy", "Run time against error on standard scenes (reference: implicit Newton, small dt)");
     cmd->add_flag("--quick", opts->quick, "Half the simulated span and fewer configurations");
-    cmd->add_option("--cache", opts->cache, "Folder for the cached reference trajectories (default: build/accuracy-cache)");
-    cmd->add_option("--json", opts->json, "Write the results as JSON to this file");
+    cmd->add_option("--cache", opts->cache, "Folder for the cached reference trajectories (default: build/accuracy-cache)")
+        ->check(non_empty_path());
+    cmd->add_option("--json", opts->json, "Write the results as JSON to this file")->check(non_empty_path());
     cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny"}));
     cmd->add_option("--mesh-dir", opts->mesh_dir,
-                    "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)");
+                    "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)")
+        ->check(non_empty_path());
     cmd->callback([opts] {
+        // Before the runs, not after them: a typo in the path would lose them.
+        if (!opts->json.empty()) check_writable("--json", opts->json);
         const std::string cache = opts->cache.empty() ? default_cache_dir() : opts->cache;
         std::filesystem::create_directories(cache);
         const std::string mesh_folder = opts->mesh_dir.empty() ? mesh_dir(default_mesh_dir()) : opts->mesh_dir;

@@ -547,15 +547,16 @@ void add_bench_layouts_command(CLI::App& app) {
     cmd->add_option("--precision", opts->precision, "Scalar type of the tet-local and tsep-list rows")
         ->check(CLI::IsMember({"double", "float"}))
         ->capture_default_str();
-    cmd->add_option("--seconds", opts->seconds, "Time budget of each measurement's timed calls")
-        ->check(CLI::PositiveNumber)
+    cmd->add_option("--seconds", opts->seconds,
+                    "Time budget of each measurement's timed calls, at most 3600 (and at most 2^22 calls)")
+        ->check(seconds_at_most(3600))
         ->capture_default_str();
     cmd->add_flag("--quick", opts->quick, "0.05 s and at least 3 calls per measurement");
     cmd->add_flag("--cachegrind", opts->cachegrind,
                   "Add D1 and LL data-cache misses per tet of the force kernel, from a run of this program under "
                   "valgrind --tool=cachegrind --cache-sim=yes per ordering (skipped with a message without valgrind)");
-    cmd->add_option("--cachegrind-calls", opts->cachegrind_calls, "Force calls measured under cachegrind per layout")
-        ->check(CLI::PositiveNumber)
+    cmd->add_option("--cachegrind-calls", opts->cachegrind_calls, "Force calls measured under cachegrind per layout (1 to 1000)")
+        ->check(int_in_range(1, 1000))
         ->capture_default_str();
     cmd->add_flag("--cachegrind-child", opts->cachegrind_child)->group("");  // internal
     cmd->callback([opts] { run_bench_layouts(*opts); });

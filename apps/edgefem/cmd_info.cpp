@@ -16,6 +16,8 @@ namespace {
 void run_info(const MeshOptions& opts) {
     const LoadedMesh lm = load_mesh(opts);
     const Mesh& mesh = lm.mesh;
+    // Volumes and dihedral angles under- or overflow past it (0 degrees).
+    check_mesh_scale(mesh, Precision::Double, opts.path);
 
     const auto t0 = std::chrono::steady_clock::now();
     const Topology topo = build_topology(mesh);

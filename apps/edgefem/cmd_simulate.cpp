@@ -182,10 +182,14 @@ void add_simulate_command(CLI::App& app) {
         "shows progress on stderr; prints median timings per step, CG iterations, the energy drift "
         "(last - first total energy, relative to the largest kinetic + elastic energy seen) and the "
         "most inverted tets in any step");
-    cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md); default: the built-in beam");
-    cmd->add_option("--out", opts->out, "Output folder (overrides the scene's output.dir; default edgefem-out)");
+    // An empty SCENE or --out would silently mean the built-in beam or the
+    // scene's folder.
+    cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md); default: the built-in beam")
+        ->check(non_empty_path());
+    cmd->add_option("--out", opts->out, "Output folder (overrides the scene's output.dir; default edgefem-out)")
+        ->check(non_empty_path());
     cmd->add_option("--steps", opts->steps, "Number of steps (overrides the scene's steps)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(int_in_range(0));
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
     add_exec_options(*cmd, opts->exec);

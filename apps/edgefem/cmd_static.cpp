@@ -21,6 +21,10 @@ struct StaticOptions {
 
 void run_static(const StaticOptions& opts) {
     const auto t0 = std::chrono::steady_clock::now();
+    // The files are written after the solve (minutes on a large mesh): a
+    // typo in the folder should not cost the solve.
+    check_writable("--out", opts.out + ".disp");
+    check_writable("--out", opts.out + ".vtu");
     SceneFile sf = load_scene_file(opts.scene);
     const auto executor = opts.exec.executor();
     OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.ordering), executor,
@@ -57,8 +61,9 @@ void add_static_command(CLI::App& app) {
         "Static equilibrium of a scene (docs/scenes.md) under gravity and its prescribed targets, by Newton "
         "with line search and automatic load stepping; writes PREFIX.disp (one 'ux uy uz' line per vertex, "
         "%.17g) and PREFIX.vtu");
-    cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md)")->required();
-    cmd->add_option("--out", opts->out, "Output file prefix")->required();
+    // An empty SCENE would mean the built-in beam (load_scene_file).
+    cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md)")->required()->check(non_empty_path());
+    cmd->add_option("--out", opts->out, "Output file prefix")->required()->check(non_empty_path());
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
     add_exec_options(*cmd, opts->exec);

@@ -9,6 +9,7 @@
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/stress_suite.hpp"
+#include "option_checks.hpp"
 #include "evidence_commands.hpp"
 
 namespace edgefem::cli {
@@ -22,17 +23,21 @@ void add_stress_command(CLI::App& app) {
     auto opts = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("stress", "Numerical stability stress suite: hard cases x integrators, pass/fail table");
     cmd->add_flag("--quick", opts->quick, "A subset of the cases, 2 simulated seconds each (well under a minute)");
-    cmd->add_option("--seconds", opts->seconds, "Simulated seconds per run of the full suite")
-        ->check(CLI::PositiveNumber)
+    // Bounded: a huge value overflows the step count (lround(seconds / dt))
+    // and would report a solver FAIL for what is a bad option.
+    cmd->add_option("--seconds", opts->seconds, "Simulated seconds per run of the full suite, at most 3600")
+        ->check(seconds_at_most(3600))
         ->capture_default_str();
     cmd->add_option("--filter", opts->filter, "Run only cases whose 'group name integrator' contains this text");
-    cmd->add_option("--json", opts->json, "Also write the results as JSON to this file");
+    cmd->add_option("--json", opts->json, "Also write the results as JSON to this file")->check(non_empty_path());
     cmd->footer(
         "Verdicts: pass (finite, energy of the free phase <= 2x its value at release, recovered to within\n"
         "1e-3 of the body size where required); failed cleanly (a SimulationError: acceptable; '(!)' marks\n"
         "one against the a-priori expectation); FAIL (silent garbage or no recovery: a bug).\n"
         "Exit codes: 0 no FAIL, 2 bad input, 3 at least one FAIL.");
     cmd->callback([opts] {
+        // Before the suite, not after it: a typo in the path would lose the run.
+        if (!opts->json.empty()) check_writable("--json", opts->json);
         StressOptions so;
         so.quick = opts->quick;
         so.seconds = opts->seconds;

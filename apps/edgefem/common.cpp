@@ -1,6 +1,7 @@
 #include "common.hpp"
 
 #include <cerrno>
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -26,8 +27,9 @@ void add_mesh_options(CLI::App& cmd, MeshOptions& opts) {
     cmd.add_option("MESH", opts.path,
                    "Mesh: a TetGen .node or .ele file or their common prefix, a Gmsh .msh, MEDIT .mesh "
                    "or Vega .veg file, or the built-in box:NXxNYxNZ (NX x NY x NZ cubes of 0.01 m, "
-                   "6 tets each; box:10x5x4 is the paper's 1,200-tet box)")
-        ->required();
+                   "6 tets each, at most 2^28 tets; box:10x5x4 is the paper's 1,200-tet box)")
+        ->required()
+        ->check(non_empty_path());
     cmd.add_flag("--fix-orientation", opts.fix_orientation,
                  "Reorient negatively oriented tets instead of rejecting the mesh");
     cmd.add_flag("--compact", opts.compact, "Remove vertices that no tet uses");
@@ -84,8 +86,47 @@ std::vector<std::string> load_warnings(const LoadedMesh& m) {
 
 void ModelOptions::validate() const {
     material.validate();
+    if (precision_kind() == Precision::Float) {
+        // The float kernels hold these, and their products with the mesh's
+        // lengths, in float: its range (1.2e-38 to 3.4e38) ends long before
+        // double's, and past it forces come out inf or NaN (Young's 1e38 did,
+        // silently). Real materials lie well inside 1e-20 to 1e20.
+        constexpr double lo = 1e-20, hi = 1e20;
+        const auto check = [&](const std::string& what, double v) {
+            if (v != 0 && !(std::abs(v) >= lo && std::abs(v) <= hi))
+                throw InvalidArgument("--precision float: " + what + " " + fmt(v, 6) +
+                                      " is outside the range float handles safely, 1e-20 to 1e20 in magnitude "
+                                      "(use --precision double)");
+        };
+        check("Young's modulus (--young)", material.young);
+        check("Lame's lambda (from --young and --poisson)", material.lambda());
+        check("Lame's mu (from --young and --poisson)", material.mu());
+        check("density (--density)", material.density);
+    }
     if (method_kind() == Method::Tet && kind() == ModelKind::SN)
         throw InvalidArgument("--method tet supports only --model fe (the spring network is edge-based only)");
+}
+
+void check_mesh_scale(const Mesh& mesh, Precision precision, const std::string& path) {
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) lo[d] = hi[d] = mesh.X.empty() ? 0.0 : mesh.X[d];
+    for (std::size_t i = 0; i < mesh.X.size(); ++i) {
+        lo[i % 3] = std::min(lo[i % 3], mesh.X[i]);
+        hi[i % 3] = std::max(hi[i % 3], mesh.X[i]);
+    }
+    const double size = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    const bool single = precision == Precision::Float;
+    // The kernels form volumes (size^3), their inverses and products with
+    // the material: these bounds keep those inside the type's range with
+    // margin (measured: a 2-tet mesh gives NaN or 0 in double below 1e-60
+    // and above 1e80, in float below 1e-20 and above 1e10).
+    const double min = single ? 1e-8 : 1e-30, max = single ? 1e8 : 1e30;
+    if (!(size >= min && size <= max))
+        throw InvalidArgument(path + ": the mesh's size (largest side of its bounding box: " + fmt(size, 3) +
+                              " m) is outside what the " + (single ? "float" : "double") + " kernels handle, " +
+                              (single ? "1e-8 to 1e8 m" : "1e-30 to 1e30 m") +
+                              " (coordinates are in metres: rescale the mesh" +
+                              (single ? ", or use --precision double)" : ")"));
 }
 
 void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required) {
@@ -133,7 +174,7 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
         ->check(CLI::IsMember({"serial", "omp", "tbb"}))
         ->capture_default_str();
     cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb back-end (0: all hardware threads)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(int_in_range(0))
         ->capture_default_str();
     cmd.add_option("--schedule", opts.schedule,
                    "How the omp/tbb back-end hands the kernels' chunks to threads: dynamic (balances uneven "

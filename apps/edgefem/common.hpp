@@ -18,6 +18,7 @@
 #include "edgefem/core/mesh.hpp"
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/validate_mesh.hpp"
+#include "option_checks.hpp"
 
 namespace edgefem::cli {
 
@@ -76,6 +77,13 @@ struct ModelOptions {
     // Throws InvalidArgument for an invalid material or --method tet --model sn.
     void validate() const;
 };
+
+// Throws InvalidArgument when the mesh's size (the largest side of its
+// bounding box) lies outside what the kernels of `precision` compute without
+// over- or underflow: 1e-30 to 1e30 m in double, 1e-8 to 1e8 m in float. Past
+// those, results came out NaN or silently 0 (a mesh scaled by 1e100 gave an
+// edge-method energy of exactly 0).
+void check_mesh_scale(const Mesh& mesh, Precision precision, const std::string& path);
 
 // Adds --model, --method, --precision, --layout, --young, --poisson, --density.
 // `material_required`: --young/--poisson must be given (forces) or default

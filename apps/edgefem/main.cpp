@@ -3,6 +3,7 @@
 // simulation fails (a SimulationError: unstable step, failed solve).
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
     edgefem::cli::add_stress_command(app);
     edgefem::cli::add_accuracy_command(app);
     edgefem::cli::add_bench_layouts_command(app);
+    edgefem::cli::reject_empty_numbers(app);
     // CLI11 would report a mistyped subcommand as "A subcommand is required".
     if (argc > 1 && argv[1][0] != '-') {
         bool known = false;
@@ -66,6 +68,9 @@ int main(int argc, char** argv) {
         return fail(e.what());
     } catch (const edgefem::SimulationError& e) {
         return fail(std::string("simulation failed: ") + e.what(), kSimulationFailedExit);
+    } catch (const std::bad_alloc&) {
+        // A bare "std::bad_alloc" names nothing.
+        return fail("out of memory (the input needs more memory than is available: try a smaller mesh)");
     } catch (const std::exception& e) {
         return fail(e.what());
     }

@@ -10,20 +10,31 @@
 
 namespace edgefem::cli {
 
+// At most this many timed calls are kept (32 MiB of durations): a tiny mesh
+// runs millions of calls a second, and one double per call would grow without
+// bound with --seconds. Past it the timing stops early; the median and
+// minimum of 4 million calls are as meaningful as those of more.
+inline constexpr std::size_t kMaxTimedCalls = std::size_t(1) << 22;
+
 // Calls `call` for a warm-up (caches, page faults, clock ramp-up: 5% of the
-// budget, at least one call), then until `seconds` have passed and at least
-// `min_calls` calls were timed; returns the timed calls' durations in ns,
+// budget, at least one call), then `warmed_up()`, then timed calls until
+// `seconds` have passed and at least `min_calls` calls were timed, or
+// `max_calls` calls were timed; returns the timed calls' durations in ns,
 // sorted.
-template <class Call>
-std::vector<double> time_calls(double seconds, Call&& call, std::size_t min_calls = 5) {
+template <class Call, class Warm = void (*)()>
+std::vector<double> time_calls(double seconds, Call&& call, std::size_t min_calls = 5,
+                               std::size_t max_calls = kMaxTimedCalls, Warm&& warmed_up = [] {}) {
     using clock = std::chrono::steady_clock;
     const auto budget = std::chrono::duration<double>(seconds);
+    max_calls = std::max(max_calls, min_calls);
     for (const auto w0 = clock::now();;) {
         call();
         if (clock::now() - w0 >= 0.05 * budget) break;
     }
+    warmed_up();
     std::vector<double> ns;
-    for (const auto start = clock::now(); ns.size() < min_calls || clock::now() - start < budget;) {
+    for (const auto start = clock::now();
+         ns.size() < min_calls || (ns.size() < max_calls && clock::now() - start < budget);) {
         const auto t0 = clock::now();
         call();
         const auto t1 = clock::now();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -24,6 +25,17 @@ Mesh make_box(index_t nx, index_t ny, index_t nz, double cell) {
     if (nt > limit || nv > limit)
         throw InvalidArgument("make_box: " + std::to_string(nt) +
                               " tets exceed the 32-bit index range");
+    // Below 2^31 a box can still ask for tens of GB (box:1000x1000x350 ended
+    // in a bare std::bad_alloc): refuse it with the size it would need.
+    if (nt > double(kMaxBoxTets)) {
+        char buf[320];
+        std::snprintf(buf, sizeof buf,
+                      "box of %d x %d x %d cells: %.3g tets, more than the limit of %lld (2^28); the mesh alone "
+                      "would take %.3g GB, and a model several times that",
+                      int(nx), int(ny), int(nz), nt, static_cast<long long>(kMaxBoxTets),
+                      (nv * 3 * sizeof(double) + nt * 4 * sizeof(index_t)) / 1e9);
+        throw InvalidArgument(buf);
+    }
 
     Mesh mesh;
     const index_t sx = nx + 1, sy = ny + 1;

@@ -3,15 +3,21 @@
 // oriented. make_box(10, 5, 4) is the paper's 1,200-tet box.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "edgefem/core/mesh.hpp"
 
 namespace edgefem {
 
+// The most tets a generated box may have (2^28, 268 million: 270 times
+// bunny-1m; its mesh alone takes 5 GB), so that a mistyped size is an error
+// naming the size rather than an out-of-memory failure.
+inline constexpr std::int64_t kMaxBoxTets = std::int64_t(1) << 28;
+
 // The box is centred at the origin. Vertex (i, j, k) has index
 // i + (NX+1) (j + (NY+1) k). Throws InvalidArgument for non-positive sizes or
-// more than 2^31-1 tets or vertices.
+// more than kMaxBoxTets tets.
 Mesh make_box(index_t nx, index_t ny, index_t nz, double cell = 0.01);
 
 // "box:NXxNYxNZ" (cubes of 0.01 m), the spelling the CLI and scene files
