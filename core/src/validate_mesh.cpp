@@ -145,7 +145,7 @@ void handle_unreferenced(Mesh& mesh, const ValidationOptions& options, Validatio
         report.warnings.push_back(std::to_string(unused) + " of " + std::to_string(nv) +
                                   " vertices are not used by any tet (the first is " +
                                   mesh.describe_vertex(first) +
-                                  "); set compact_unreferenced to remove them");
+                                  "); remove them with the compact option (ValidationOptions::compact_unreferenced, CLI --compact, scene mesh_options.compact)");
         return;
     }
     report.warnings.push_back("removed " + std::to_string(unused) +

@@ -98,14 +98,19 @@ using clock_type = std::chrono::steady_clock;
 // Times `call` for about `seconds` after a short warm-up; returns sorted ns.
 template <class Call>
 std::vector<double> time_calls(double seconds, Call&& call) {
-    if (!(seconds > 0)) throw InvalidArgument("seconds must be positive");
+    // As `edgefem bench`: a bounded budget, and at most 2^22 stored samples
+    // (32 MiB), so a tiny mesh and a long budget cannot eat the memory.
+    if (!(seconds > 0) || !(seconds <= 3600))
+        throw InvalidArgument("seconds must be positive and at most 3600, got " + std::to_string(seconds));
+    constexpr std::size_t kMaxCalls = std::size_t(1) << 22;
     const auto budget = std::chrono::duration<double>(seconds);
     for (const auto w0 = clock_type::now();;) {
         call();
         if (clock_type::now() - w0 >= 0.05 * budget) break;
     }
     std::vector<double> ns;
-    for (const auto start = clock_type::now(); ns.size() < 5 || clock_type::now() - start < budget;) {
+    for (const auto start = clock_type::now();
+         ns.size() < 5 || (ns.size() < kMaxCalls && clock_type::now() - start < budget);) {
         const auto t0 = clock_type::now();
         call();
         ns.push_back(std::chrono::duration<double, std::nano>(clock_type::now() - t0).count());

@@ -215,3 +215,7 @@ def test_vtu_series(tmp_path):
 def test_bench_forces():
     r = edgefem.bench_forces(small_box(), seconds=0.05)
     assert r["calls"] >= 5 and r["median_ns_per_tet"] > 0
+    # A budget that never ends (or absurdly long) is refused, not run.
+    for bad in (float("inf"), float("nan"), 1e300, 0.0):
+        with pytest.raises(edgefem.InvalidArgument):
+            edgefem.bench_forces(small_box(), seconds=bad)
