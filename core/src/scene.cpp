@@ -67,6 +67,14 @@ void Scene::validate() const {
     if (solver.load_steps < 1) bad("solver.load_steps", "must be >= 1");
     if (solver.max_step_halvings < 0) bad("solver.max_step_halvings", "must be >= 0");
     if (solver.stiffness_interval < 1) bad("solver.stiffness_interval", "must be >= 1");
+    // Settings that only the semi-implicit step with CG reads: elsewhere
+    // they were accepted and silently ignored.
+    const bool semi_cg = integrator == Integrator::SemiImplicit && solver.linear_solver == LinearSolver::CG;
+    if (solver.stiffness_interval > 1 && !semi_cg)
+        bad("solver.stiffness_interval", "> 1 applies only to the semi-implicit integrator with the cg solver");
+    if (solver.cg_fixed_iterations > 0 && !semi_cg)
+        bad("solver.cg_fixed_iterations",
+            "> 0 applies only to the semi-implicit integrator with the cg solver (Newton's solves run to their tolerance)");
     if (!std::isfinite(solver.max_energy_growth) || (solver.max_energy_growth != 0 && !(solver.max_energy_growth >= 1)))
         bad("solver.max_energy_growth", "must be 0 (off) or a finite number >= 1, got " + std::to_string(solver.max_energy_growth));
     std::vector<char> seen(nv, 0);

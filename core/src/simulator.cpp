@@ -139,6 +139,7 @@ struct Simulator<S>::Impl {
     std::vector<double> mass_dof;                 // 3 #V: mass per dof, for loops that vectorise
     std::vector<S> u, v, fext, f;                 // 3 #V
     std::vector<S> step_start_u, step_start_v;    // the state before the step (restored when it fails)
+    double ramp_floor = 0;                        // 1 after solve_static: the prescribed targets are reached
     std::vector<std::uint8_t> free_dof;           // 3 #V
     std::vector<index_t> con_vertex;              // fixed and prescribed vertices
     std::vector<std::array<double, 3>> con_disp;  // their final displacement
@@ -229,7 +230,7 @@ struct Simulator<S>::Impl {
 
     // Fraction of the prescribed targets reached at time t.
     double ramp(double t) const {
-        return std::min(1.0, t / (scene.prescribed_steps * scene.dt) * (1 + 1e-12));
+        return std::max(ramp_floor, std::min(1.0, t / (scene.prescribed_steps * scene.dt) * (1 + 1e-12)));
     }
 
     // y = op x with double vectors (converts for float models).
@@ -299,12 +300,16 @@ struct Simulator<S>::Impl {
     // with the plain K it retries once with the definite K.
     // `reuse_stiffness`: keep the K and preconditioner of an earlier solve
     // (matrix-free CG only; see SolverSettings::stiffness_interval).
-    CgResult solve(double c_m, double c_k, double c_b, double tolerance, bool definite, bool reuse_stiffness = false) {
-        CgResult res = solve_once(c_m, c_k, c_b, tolerance, definite, reuse_stiffness);
+    // `fixed_iterations` > 0: exactly that many CG iterations (the
+    // semi-implicit step's budget, cg_fixed_iterations; Newton's solves
+    // always run to their tolerance: with the budget they failed to converge).
+    CgResult solve(double c_m, double c_k, double c_b, double tolerance, bool definite, bool reuse_stiffness = false,
+                   int fixed_iterations = 0) {
+        CgResult res = solve_once(c_m, c_k, c_b, tolerance, definite, reuse_stiffness, fixed_iterations);
         if (res.negative_curvature && !definite && scene.method == Method::Edge) {
             stats.negative_curvature = true;
             const int its = res.iterations;
-            res = solve_once(c_m, c_k, c_b, tolerance, true);
+            res = solve_once(c_m, c_k, c_b, tolerance, true, false, fixed_iterations);
             res.iterations += its;
         }
         return res;
@@ -329,7 +334,7 @@ struct Simulator<S>::Impl {
     }
 
     CgResult solve_once(double c_m, double c_k, double c_b, double tolerance, bool definite,
-                        bool reuse_stiffness = false) {
+                        bool reuse_stiffness = false, int fixed_iterations = 0) {
         auto t0 = Clock::now();
         reuse_stiffness = reuse_stiffness && scene.solver.linear_solver == LinearSolver::CG;
         if (!reuse_stiffness) op->build_stiffness(definite);
@@ -399,7 +404,7 @@ struct Simulator<S>::Impl {
                     for (int i = 0; i < 3; ++i) z[3 * vtx + i] = zv[i];
                 }
             },
-            b.data(), x.data(), tolerance, scene.solver.cg_max_iterations, scene.solver.cg_fixed_iterations, cg);
+            b.data(), x.data(), tolerance, scene.solver.cg_max_iterations, fixed_iterations, cg);
         if (s != 1) each([&](std::size_t i) {
             b[i] *= s;
             x[i] *= s;
@@ -473,7 +478,12 @@ struct Simulator<S>::Impl {
         W_evaluated = W_end;
         evaluated_valid = true;
         const EnergySample end = sample(W_end);
-        const double scale = std::max(energy_scale, start.kinetic + start.elastic);
+        // The reference is net of the gains counted so far: the start's own
+        // kinetic + elastic energy includes them, and with it a steady
+        // growth of 1.2-3x per step raised its own bound and was never
+        // caught (a bent beam, explicit just past the stable dt, reached
+        // 460x its release energy with every step passing).
+        const double scale = std::max(energy_scale, start.kinetic + start.elastic - energy_excess);
         double excess = energy_excess;
         if (!constraints_moved) {
             const double damping = 2 * T * scene.rayleigh_alpha * end.kinetic;
@@ -588,7 +598,8 @@ struct Simulator<S>::Impl {
         // Reuse K while the interval allows and the step size is the one it
         // was built for (a halved step changes the system matrix).
         const bool reuse = stiffness_age > 0 && stiffness_age < scene.solver.stiffness_interval && T == stiffness_dt;
-        const CgResult res = solve(c_m, c_k, 0.0, scene.solver.cg_tolerance, scene.solver.definite_stiffness, reuse);
+        const CgResult res =
+            solve(c_m, c_k, 0.0, scene.solver.cg_tolerance, scene.solver.definite_stiffness, reuse, scene.solver.cg_fixed_iterations);
         stiffness_age = reuse ? stiffness_age + 1 : 1;
         stiffness_dt = T;
         stats.residual = res.residual;
@@ -888,6 +899,10 @@ struct Simulator<S>::Impl {
             done = load;
             ++result.load_steps;
         }
+        // The targets are reached: later steps hold them there instead of
+        // restarting the ramp from time 0 (which pulled the prescribed
+        // vertices back to rest at 100x their speed).
+        ramp_floor = 1;
         result.newton_iterations = stats.newton_iterations;
         result.residual = stats.residual;
         result.converged = true;

@@ -15,7 +15,7 @@ namespace edgefem {
 
 struct CgResult {
     int iterations = 0;
-    double residual = 0;  // |P(b - A x)| / |P b| at exit (|P b| = 0: absolute)
+    double residual = 0;  // |P(b - A x)| / |P(b - A x_c)| at exit, x_c: x's constrained values (0 denominator: absolute)
     bool converged = false;
     bool negative_curvature = false;  // met p^T A p <= 0: stopped at the last good iterate
 };
@@ -87,6 +87,29 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
     };
 
     CgResult res;
+    // The residual is relative to |P(b - A x_c)|, x_c = x's constrained
+    // values: the right-hand side the free dofs actually see. With moving
+    // constraints (a prescribed ramp, the only load) P b alone is zero, and
+    // dividing by 1 instead made the tolerance absolute: on a soft body
+    // CG stopped after 0 iterations with the free vertices unmoved. The
+    // extra product runs only when a constrained value is non-zero.
+    bool moving_constraints = false;
+    for (std::size_t i = 0; i < n && !moving_constraints; ++i) moving_constraints = !free_dof[i] && x[i] != 0;
+    double bnorm = 0;
+    if (moving_constraints) {
+        for (std::size_t i = 0; i < n; ++i) z[i] = free_dof[i] ? 0.0 : x[i];
+        apply_A(z, Ap);
+        ex.for_uniform_phases(1, phase_first, [&](int, index_t g) {
+            blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
+                finish_A(lo, hi, z, Ap);
+                bb_part[k] = block_sum(lo, hi, [=](std::size_t i) {
+                    const double d = (b[i] - Ap[i]) * (free_dof[i] ? 1.0 : 0.0);
+                    return d * d;
+                });
+            });
+        });
+        bnorm = std::sqrt(total(bb_part));
+    }
     apply_A(x, Ap);
     ex.for_uniform_phases(1, phase_first, [&](int, index_t g) {
         blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
@@ -100,7 +123,7 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
             rz_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * p[i]; });
         });
     });
-    const double bnorm = std::sqrt(total(bb_part));
+    if (!moving_constraints) bnorm = std::sqrt(total(bb_part));
     const double scale = bnorm > 0 ? bnorm : 1.0;
     res.residual = std::sqrt(total(rr_part)) / scale;
     const int limit = fixed_iterations > 0 ? fixed_iterations : max_iterations;

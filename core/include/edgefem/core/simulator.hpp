@@ -94,7 +94,8 @@ public:
     const StepStats& step();
     // Static equilibrium under gravity, external forces and the prescribed
     // targets (reached fully), by Newton with line search and automatic load
-    // stepping; the result becomes the state (velocity zero).
+    // stepping; the result becomes the state (velocity zero), and later
+    // steps hold the prescribed vertices at their targets.
     StaticResult solve_static();
 
     // Zero-copy views (3 #V, xyz per vertex). External forces are the
