@@ -29,6 +29,13 @@ std::string sci(double v) {
     return buf;
 }
 
+// A load fraction with the digits that tell close increments apart.
+std::string fmt_load(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return buf;
+}
+
 // Inverse of the symmetric part of B (row-major into inv) by Cholesky;
 // false when it is not positive definite. Written out for 3x3: Eigen's LLT
 // solve against the identity went through its general triangular solver
@@ -877,6 +884,10 @@ struct Simulator<S>::Impl {
         stats = StepStats{};
         StaticResult result;
         const std::vector<double> none;
+        // The increment halves on a failure, at most 12 times in a row (the
+        // budget had counted over the whole solve, so more load steps could
+        // fail where fewer converged). Growing it back after successes was
+        // tried: on a squashed bar it cost 2-15x the Newton iterations.
         double done = 0, inc = 1.0 / scene.solver.load_steps;
         int halvings = 0;
         while (done < 1 - 1e-15) {
@@ -890,14 +901,16 @@ struct Simulator<S>::Impl {
             } catch (const StepFailure& failure) {
                 u = u_save;
                 if (++halvings > 12)
-                    throw SimulationError("static solve: " + failure.message + " even with load increment " +
-                                              sci(inc) + " (after 12 halvings)",
+                    throw SimulationError("static solve: load fraction " + fmt_load(done) + " -> " + fmt_load(load) + ": " +
+                                              failure.message + " even with load increment " + sci(inc) +
+                                              " (after 12 halvings in a row)",
                                           step, failure.vertex);
                 inc /= 2;
                 continue;
             }
             done = load;
             ++result.load_steps;
+            halvings = 0;
         }
         // The targets are reached: later steps hold them there instead of
         // restarting the ramp from time 0 (which pulled the prescribed
