@@ -397,6 +397,11 @@ void add_accuracy_command(CLI::App& app) {
     cmd->add_option("--mesh-dir", opts->mesh_dir,
                     "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)")
         ->check(non_empty_path());
+    // Its own footer: the main one (inherited otherwise) describes MESH,
+    // which this command does not take.
+    cmd->footer(
+        "Errors print one line 'edgefem: error: ...' to stderr. Exit codes: 0 ok, 2 bad input,\n"
+        "3 simulation failed (a reference trajectory failed; a configuration that fails is a row 'failed cleanly').");
     cmd->callback([opts] {
         // Before the runs, not after them: a typo in the path would lose them.
         if (!opts->json.empty()) check_writable("--json", opts->json);

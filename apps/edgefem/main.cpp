@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
                  "edgefem"};
     app.set_version_flag("--version", EDGEFEM_VERSION);
     app.require_subcommand(1);
+    // Subcommands inherit this footer when they are added: those without a
+    // MESH (simulate, static, stress, accuracy) set their own.
     app.footer(
         "MESH is a TetGen .node/.ele file or their common prefix, a Gmsh .msh, MEDIT .mesh or Vega .veg\n"
         "file, or box:NXxNYxNZ, a generated box of NX x NY x NZ cubes of 0.01 m split into 6 tets each\n"

@@ -37,7 +37,7 @@ SceneFile parse_scene(const std::string& text, const std::string& base_dir,
                       const std::string& source_name);
 
 // The built-in scene `edgefem simulate` runs without a file: a soft beam
-// (make_box(40, 10, 8, 0.005): 19,200 tets, 0.2 x 0.05 x 0.04 m; Y = 1e5 Pa,
+// (make_box(40, 10, 8, 0.005): 19,200 tets, 0.2 x 0.05 x 0.04 m; Y = 1e6 Pa,
 // nu = 0.3, rho = 1000) clamped at its x = min end and sagging under gravity
 // -z, semi-implicit, dt = 1 ms, 1000 steps.
 Scene default_scene();

@@ -1,12 +1,14 @@
 // Elastic operators whose kernels run on an Executor, for the Simulator:
 //
 //   auto ex = make_executor(Backend::TBB, 2);
-//   Simulator<double> sim(scene, ex, parallel_operator_factory<double>(ex));  // gather variant
+//   Simulator<double> sim(scene, ex, parallel_operator_factory<double>(ex));  // Variant::Auto
 //
-// The executor runs the CG vector operations, the factory's operators run
-// forces, stiffness, K x, diagonal blocks and the inverted-tet count on the
-// same executor. Colour and gather give bitwise the same step for any thread
-// count.
+// Variant::Auto, the default, picks owner when the vertex numbering has
+// locality, else gather. The executor runs the CG vector operations, the
+// factory's operators run forces, stiffness, K x, diagonal blocks and the
+// inverted-tet count on the same executor. Colour, gather and owner (hence
+// Auto) are deterministic: each gives bitwise the same step for any thread
+// count (is_deterministic in variant.hpp).
 #pragma once
 
 #include <memory>
