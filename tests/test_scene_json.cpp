@@ -208,8 +208,10 @@ TEST(SceneJson, CompactionRenumbersSelectedVertices) {
     EXPECT_EQ(sf.scene.fixed, (std::vector<index_t>{0, 5}));
     expect_error("{" + mesh + R"(, "mesh_options": {"compact": true}, "fixed": {"vertices": [5]}})",
                  {"\"fixed\"", "selects no vertex"});
-    // Without it the vertex is kept, with a warning.
-    EXPECT_FALSE(parse("{" + mesh + "}").warnings.empty());
+    // Without it the scene is an error naming the vertex in the file's
+    // numbering (it would have no mass; the Simulator found it only after
+    // renumbering, and named it in the internal numbering).
+    expect_error("{" + mesh + "}", {"\"mesh\"", "used by no tet", "compact"});
 }
 
 TEST(SceneJson, DefaultScene) {

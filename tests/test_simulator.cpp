@@ -768,3 +768,21 @@ TEST(Simulator, StepAfterStaticKeepsPrescribedTargets) {
         EXPECT_NEAR(sim.velocity()[3 * tip], 0.0, 1e-9) << to_string(integrator);
     }
 }
+
+// An explicit step far past the stability limit from rest: the guard fails
+// it and gives the gain itself, not a ratio to a reference of 0 J (it
+// printed "+6.18e+288 x").
+TEST(Simulator, GuardMessageFromRestGivesTheGain) {
+    Scene s = test::clamped_box_scene(4, 1, 1, 1e12);
+    s.integrator = Integrator::Explicit;
+    s.dt = 1e-5;
+    Simulator<double> sim(std::move(s));
+    try {
+        for (int k = 0; k < 5; ++k) sim.step();
+        FAIL() << "no error";
+    } catch (const SimulationError& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("no kinetic or elastic energy"), std::string::npos) << msg;
+        EXPECT_EQ(msg.find("e+2"), std::string::npos) << msg;  // no 1e200-size ratio
+    }
+}

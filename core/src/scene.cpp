@@ -38,6 +38,18 @@ void Scene::validate() const {
     // binding), so the mesh is checked here, not only where files are read:
     // an index out of range would otherwise reach the topology build.
     check_mesh(mesh);
+    // A vertex no tet uses has no mass: the Simulator cannot move it. Said
+    // here, on the scene as given, so the message keeps the user's (and the
+    // file's) numbering; the Simulator found it only after renumbering.
+    {
+        std::vector<char> used(nv, 0);
+        for (const index_t v : mesh.tets) used[v] = 1;
+        for (index_t v = 0; v < nv; ++v)
+            if (!used[v])
+                bad("mesh", mesh.describe_vertex(v) + " is used by no tet (it would have no mass); remove unreferenced "
+                    "vertices with the compact option (ValidationOptions::compact_unreferenced, CLI --compact, "
+                    "scene mesh_options.compact)");
+    }
     // Enums that came in as integers (bindings, casts) must name a value.
     if (model != ModelKind::FE && model != ModelKind::SN) bad("model", "not a model (fe or sn)");
     if (method != Method::Edge && method != Method::Tet) bad("method", "not a method (edge or tet)");

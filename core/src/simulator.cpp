@@ -520,10 +520,19 @@ struct Simulator<S>::Impl {
                 char ratio[48], lim[32];
                 std::snprintf(ratio, sizeof ratio, "+%.3g x", excess / std::max(scale, 1e-300));
                 std::snprintf(lim, sizeof lim, "%g", limit);
-                throw StepFailure{"step " + std::to_string(step + 1) + ": energy grew without a source: " + ratio +
-                                      " the largest kinetic + elastic energy seen (a gain of " + sci(excess) +
-                                      " J net of the external work since its lowest level; largest " + sci(scale) +
-                                      " J), over solver.max_energy_growth = " + lim + "; fastest vertex " +
+                // From rest (no kinetic or elastic energy yet) a ratio means
+                // nothing (it printed +6e288 x): give the gain itself.
+                const bool from_rest = !(excess < 1e12 * scale);
+                throw StepFailure{"step " + std::to_string(step + 1) + ": energy grew without a source: " +
+                                      (from_rest ? "a gain of " + sci(excess) +
+                                                       " J net of the external work, by a body that had no kinetic or "
+                                                       "elastic energy to speak of (" + sci(scale) + " J)"
+                                                 : std::string(ratio) +
+                                                       " the largest kinetic + elastic energy seen (a gain of " +
+                                                       sci(excess) +
+                                                       " J net of the external work since its lowest level; largest " +
+                                                       sci(scale) + " J)") +
+                                      ", over solver.max_energy_growth = " + lim + "; fastest vertex " +
                                       std::to_string(vertex) +
                                       " (unstable: reduce dt, use the implicit integrator or improve the mesh's worst tets)",
                                   vertex};
