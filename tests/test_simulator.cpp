@@ -21,6 +21,17 @@ namespace {
 
 Scene cantilever(Integrator integrator, double dt) { return test::cantilever_scene(integrator, dt); }
 
+// Constructing a Simulator on `s` throws E, its message containing `what`.
+template <class E>
+void expect_rejected(Scene s, const std::string& what) {
+    try {
+        Simulator<double> sim(std::move(s));
+        ADD_FAILURE() << "accepted: " << what;
+    } catch (const E& e) {
+        EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+}
+
 double total_mass(const Simulator<double>& sim) {
     double m = 0;
     for (double x : sim.lumped_mass()) m += x;
@@ -253,14 +264,7 @@ TEST(Simulator, FloatTracksDoubleAndSceneErrorsNameTheField) {
     }
     EXPECT_LT(diff, 1e-4 * ref);
 
-    auto expect_field = [](Scene s, const char* field) {
-        try {
-            Simulator<double> sim(std::move(s));
-            ADD_FAILURE() << "accepted bad " << field;
-        } catch (const InvalidArgument& e) {
-            EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-        }
-    };
+    const auto expect_field = expect_rejected<InvalidArgument>;
     Scene s = cantilever(Integrator::SemiImplicit, 1e-3);
     s.dt = -1;
     expect_field(s, "\"dt\"");
@@ -570,14 +574,7 @@ TEST(Simulator, NewtonAcceptsItsRoundOffFloorButNotAStuckSolve) {
 // validation: every mesh fault is a MeshError naming it, never a crash in
 // the topology build or silent nonsense (an inverted or duplicate tet).
 TEST(Simulator, HandMadeSceneMeshIsChecked) {
-    const auto expect_mesh_error = [](Scene s, const std::string& what) {
-        try {
-            Simulator<double> sim(std::move(s));
-            ADD_FAILURE() << "accepted: " << what;
-        } catch (const MeshError& e) {
-            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
-        }
-    };
+    const auto expect_mesh_error = expect_rejected<MeshError>;
     const Scene good = cantilever(Integrator::SemiImplicit, 1e-3);
     Scene s = good;
     s.mesh.tets[5] = -5;
@@ -610,14 +607,7 @@ TEST(Simulator, HandMadeSceneMeshIsChecked) {
 
 // Enums that arrive as integers (bindings, casts) must name a value.
 TEST(Simulator, OutOfRangeEnumsAreErrors) {
-    const auto expect_field = [](Scene s, const char* field) {
-        try {
-            Simulator<double> sim(std::move(s));
-            ADD_FAILURE() << "accepted bad " << field;
-        } catch (const InvalidArgument& e) {
-            EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-        }
-    };
+    const auto expect_field = expect_rejected<InvalidArgument>;
     Scene s = cantilever(Integrator::SemiImplicit, 1e-3);
     s.integrator = static_cast<Integrator>(7);
     expect_field(s, "\"integrator\"");
