@@ -93,8 +93,9 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
     // dividing by 1 instead made the tolerance absolute: on a soft body
     // CG stopped after 0 iterations with the free vertices unmoved. The
     // extra product runs only when a constrained value is non-zero.
-    bool moving_constraints = false;
-    for (std::size_t i = 0; i < n && !moving_constraints; ++i) moving_constraints = !free_dof[i] && x[i] != 0;
+    int any_moving = 0;  // branch-free, so the scan vectorises (it runs once per solve)
+    for (std::size_t i = 0; i < n; ++i) any_moving |= int(free_dof[i] == 0) & int(x[i] != 0);
+    const bool moving_constraints = any_moving != 0;
     double bnorm = 0;
     if (moving_constraints) {
         for (std::size_t i = 0; i < n; ++i) z[i] = free_dof[i] ? 0.0 : x[i];
