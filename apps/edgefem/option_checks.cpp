@@ -8,19 +8,10 @@
 #include <cstring>
 #include <filesystem>
 
+#include "common.hpp"
 #include "edgefem/core/error.hpp"
 
 namespace edgefem::cli {
-
-namespace {
-
-std::string g6(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
-
-}  // namespace
 
 CLI::Validator int_in_range(long long min, long long max) {
     const bool bounded = max != std::numeric_limits<long long>::max();
@@ -42,7 +33,7 @@ CLI::Validator int_in_range(long long min, long long max) {
 }
 
 CLI::Validator seconds_at_most(double max) {
-    const std::string want = "expected a number of seconds > 0 and <= " + g6(max);
+    const std::string want = "expected a number of seconds > 0 and <= " + fmt(max, 6);
     return CLI::Validator(
         [max, want](std::string& s) {
             double v = 0;
@@ -52,7 +43,7 @@ CLI::Validator seconds_at_most(double max) {
                 return want + ", got '" + s + "'";
             return std::string();
         },
-        "POSITIVE <= " + g6(max));
+        "POSITIVE <= " + fmt(max, 6));
 }
 
 CLI::Validator non_empty_path() {
