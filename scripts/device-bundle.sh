@@ -8,21 +8,23 @@
 #   .devbundle/run.sh bp NAME FILTER SECONDS [benchmark flags]
 #       edgefem_bench_parallel with that filter, 3 repetitions, medians to
 #       $OUT/NAME.log and NAME.json (bench/scaling_tables reads the log)
+#   .devbundle/run.sh tests [gtest flags]  # the parallel and simulator tests
+#       (bitwise determinism at 1..16 threads on real cores) -> $OUT/tests.log
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=.devbundle
 grep -qs "^/$B/" .git/info/exclude || { mkdir -p .git/info && echo "/$B/" >> .git/info/exclude; }
 cmake -S . -B build-dev -DCMAKE_BUILD_TYPE=Release -DEDGEFEM_NATIVE=OFF -DCMAKE_CXX_FLAGS=-march=x86-64-v3 \
-      -DEDGEFEM_BUILD_TESTS=OFF -DEDGEFEM_BUILD_PYTHON=OFF -DEDGEFEM_BUILD_EXAMPLES=OFF > /dev/null
-cmake --build build-dev -j "$(nproc)" --target edgefem_bench_parallel edgefem
+      -DEDGEFEM_BUILD_TESTS=ON -DEDGEFEM_BUILD_PYTHON=OFF -DEDGEFEM_BUILD_EXAMPLES=OFF > /dev/null
+cmake --build build-dev -j "$(nproc)" --target edgefem_bench_parallel edgefem edgefem_test_parallel_kernels edgefem_test_parallel_simulator edgefem_test_parallel_executors edgefem_test_async_tangent
 rm -rf "$B" && mkdir -p "$B/bin" "$B/lib" "$B/meshes"
-cp build-dev/bin/edgefem_bench_parallel build-dev/bin/edgefem "$B/bin/"
+cp build-dev/bin/edgefem_bench_parallel build-dev/bin/edgefem build-dev/bin/edgefem_test_* "$B/bin/"
 for l in $(ldd "$B"/bin/* | awk '/=>/ {print $3}' | sort -u) /lib/x86_64-linux-gnu/libtbbmalloc.so.2; do
     [ -f "$l" ] && cp -L "$l" "$B/lib/"
 done
 cp -L /lib64/ld-linux-x86-64.so.2 "$B/lib/"
 mesh_dir=${EDGEFEM_MESH_DIR:-../shared/meshes}
-for m in box-1200 bunny-4k armadillo-7k bunny-250k bunny-1m; do
+for m in box-1200 spot-2k bunny-4k armadillo-7k bunny-250k bunny-1m; do
     for e in node ele; do [ -f "$mesh_dir/$m.$e" ] && gzip -6 -c "$mesh_dir/$m.$e" > "$B/meshes/$m.$e.gz"; done
 done
 cat > "$B/run.sh" <<'RUN'
@@ -42,6 +44,13 @@ bp() {
     --benchmark_min_time=0.15 --benchmark_out="$OUT/$name.json" --benchmark_out_format=json "$@" 2>&1 \
     | grep -v "_stddev\|_cv\|_mean" > "$OUT/$name.log"
   echo "$name rc=${PIPESTATUS[0]} rows=$(grep -c median "$OUT/$name.log")"
+}
+tests() {
+  local rc=0
+  for t in edgefem_test_parallel_kernels edgefem_test_parallel_simulator edgefem_test_parallel_executors edgefem_test_async_tangent; do
+    X "$B/bin/$t" --gtest_brief=1 "$@" >> "$OUT/tests.log" 2>&1 || rc=1
+  done
+  tail -5 "$OUT/tests.log"; echo "tests rc=$rc"
 }
 export B; export -f X
 "$@"

@@ -12,6 +12,7 @@
 #include "edgefem/parallel/barrier_latency.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/variant.hpp"
+#include "test_threads.hpp"
 
 using namespace edgefem;
 
@@ -64,7 +65,7 @@ TEST(Executors, BlockedSumIndependentOfThreads) {
     for (std::size_t i = 0; i < n; ++i) a[i] = std::sin(0.37 * double(i)) * std::exp(double(i % 97) / 7);
     const double ref = blocked_sum(SerialExecutor{}, n, [&](std::size_t i) { return a[i]; });
     for (Backend b : {Backend::OpenMP, Backend::TBB})
-        for (int t : {1, 2, 3, 4, 8}) {
+        for (int t : edgefem::test::test_thread_counts()) {
             const auto ex = make_executor(b, t);
             EXPECT_EQ(blocked_sum(*ex, n, [&](std::size_t i) { return a[i]; }), ref);
         }

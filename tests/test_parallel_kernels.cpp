@@ -1,5 +1,5 @@
 // Parallel back-ends: every kernel (forces + energy, stiffness, K x,
-// diagonal blocks) under OpenMP and TBB at 1, 2, 3, 4 and 8 threads.
+// diagonal blocks) under OpenMP and TBB at 1, 2, 3, 4 and 8 threads (and the cores present, above 8).
 // Colour and gather: bitwise equal across thread counts and to the
 // SerialExecutor run of the same variant. Atomic and private: within 1e-12
 // of it. Every variant: within 1e-12 of core's serial kernels. The same
@@ -18,6 +18,7 @@
 #include "edgefem/parallel/parallel_tet_kernels.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
+#include "test_threads.hpp"
 #include "write_sets.hpp"
 
 using namespace edgefem;
@@ -26,10 +27,9 @@ using edgefem::test::rel_diff;
 namespace {
 
 constexpr long kMaxTets = 5000;
-// Above this size only 1 and 2 threads run: more threads than the 2 cores of
-// the development machine make OpenMP's barriers slow (correctness is
-// covered by the smaller meshes at 3, 4 and 8 threads).
-constexpr long kOversubscribeMaxTets = 1500;  // generated boxes and box-1200 (more threads than cores make larger meshes slow)
+// Above this size no more threads than cores run (test_threads.hpp;
+// correctness is covered by the smaller meshes at every count).
+constexpr long kOversubscribeMaxTets = 1500;  // generated boxes and box-1200
 
 const std::vector<edgefem::test::NamedMesh>& meshes() {
     static const auto m = edgefem::test::test_meshes(kMaxTets);
@@ -45,7 +45,7 @@ const std::vector<NamedExecutor>& executors() {
     static const auto list = [] {
         std::vector<NamedExecutor> v;
         for (Backend b : {Backend::OpenMP, Backend::TBB})
-            for (int t : {1, 2, 3, 4, 8})
+            for (int t : edgefem::test::test_thread_counts())
                 for (Schedule s : {Schedule::Dynamic, Schedule::Static}) {
                     if (s == Schedule::Static && t != 3) continue;  // one static run per backend
                     v.push_back({std::string(to_string(b)) + "-" + std::to_string(t) + "-" + to_string(s),
@@ -161,7 +161,7 @@ void check_edge_kernels(double core_tol) {
                 const Outputs<S> serial = run_parallel<Kind>(models.edge, std::make_shared<SerialExecutor>(), v, u, x, {}, fm);
                 expect_close(serial, core, core_tol, tag + "/serial vs core");
                 for (const auto& ne : executors()) {
-                    if (nm.mesh.num_tets() > kOversubscribeMaxTets && ne.ex->threads() > 2) continue;
+                    if (edgefem::test::skip_oversubscribed(nm.mesh.num_tets(), ne.ex->threads(), kOversubscribeMaxTets)) continue;
                     const Outputs<S> par = run_parallel<Kind>(models.edge, ne.ex, v, u, x, {}, fm);
                     if (is_deterministic(v))
                         expect_bitwise(par, serial, tag + "/" + ne.name);
@@ -370,7 +370,7 @@ TEST(ParallelTetKernels, MatchSerial) {
             EXPECT_LE(rel_diff(serial.y, y0), 1e-12);
             EXPECT_LE(rel_diff(serial.D, D0), 1e-12);
             for (const auto& ne : executors()) {
-                if (nm.mesh.num_tets() > kOversubscribeMaxTets && ne.ex->threads() > 2) continue;
+                if (edgefem::test::skip_oversubscribed(nm.mesh.num_tets(), ne.ex->threads(), kOversubscribeMaxTets)) continue;
                 const auto par = run(ne.ex);
                 const std::string tag = nm.name + "/" + to_string(v) + "/" + ne.name;
                 if (v == Variant::Colour) {

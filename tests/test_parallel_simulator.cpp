@@ -14,6 +14,7 @@
 #include "edgefem/parallel/parallel_operator.hpp"
 #include "cantilever.hpp"
 #include "models.hpp"
+#include "test_threads.hpp"
 
 using namespace edgefem;
 using edgefem::test::rel_diff;
@@ -64,7 +65,7 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
             EXPECT_LE(rel_diff(serial.u, core.u), 1e-12) << tag;
             EXPECT_LE(rel_diff(serial.v, core.v), 1e-12) << tag;
             for (Backend b : {Backend::OpenMP, Backend::TBB})
-                for (int t : {1, 2, 3, 4, 8}) {
+                for (int t : edgefem::test::test_thread_counts()) {
                     const auto ex = make_executor(b, t);
                     const Result par = run(method, ex, parallel_operator_factory<double>(ex, var));
                     const std::string where = tag + "/" + to_string(b) + "-" + std::to_string(t);

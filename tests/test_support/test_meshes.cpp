@@ -18,19 +18,19 @@ std::vector<NamedMesh> test_meshes(long max_tets) {
     out.push_back({"box1", make_box(1, 1, 1)});
     out.push_back({"box10x5x4", make_box(10, 5, 4)});
     out.push_back({"box3x4x5", make_box(3, 4, 5, 0.02)});
-    bool missing = false;
+    std::string missing;
     for (const auto& info : shared_mesh_table()) {
         if (info.tets > max_tets) continue;
         const std::string prefix = shared_mesh_prefix(info.name);
         if (prefix.empty()) {
-            missing = true;
+            missing += std::string(missing.empty() ? "" : ", ") + info.name;
             continue;
         }
         out.push_back({info.name, read_tetgen(prefix)});
     }
-    if (missing)
-        std::fprintf(stderr, "note: shared meshes not found under %s; testing generated boxes only\n",
-                     shared_mesh_dir().c_str());
+    if (!missing.empty())
+        std::fprintf(stderr, "note: shared meshes not found under %s (%s); testing the others and generated boxes\n",
+                     shared_mesh_dir().c_str(), missing.c_str());
     return out;
 }
 
