@@ -36,6 +36,7 @@
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
 #include "edgefem/parallel/parallel_edge_kernels.hpp"
+#include "edgefem/parallel/stream_bandwidth.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 
@@ -74,21 +75,13 @@ Prepared& prepared(const std::string& name) {
     return *p;
 }
 
-// Compulsory traffic of one FE force call (each array streamed once per
-// pass that touches it; random reads of u and zeta counted once):
-// pass 1 reads edge, rest, L(E), u and writes p~, zeta, g; pass 2 reads the
-// segments (first, E1, L(P)) or, with the tet-local form, its edge ids and
-// rows, reads zeta and updates g; pass 3 reads edge, p~, g and writes f
-// (zeroed first).
+// Compulsory traffic of one FE force call, as `edgefem bench` counts it
+// (stream_bandwidth.hpp, TrafficModel::Compulsory): every array once, the
+// state (p~, zeta, g) written once and, unless the tet-local form runs in
+// cache-sized tiles, read back once. `form`: g from the tet-local form.
 double force_bytes(const Prepared& p, bool form) {
-    const EdgeModel<double>& m = p.model;
-    const double E = m.num_edges(), P = m.num_tseps(), V = m.num_vertices, s = sizeof(double);
-    const double pass1 = E * (8 + 3 * s + s) + 3 * s * V + E * (3 * s + s + 8);
-    const double pairs = form ? double(p.form.edge.size() * sizeof(index_t) + p.form.A.size() * sizeof(double))
-                              : E * 4 + P * (4 + s);
-    const double pass2 = pairs + E * s + 2 * E * 8;
-    const double pass3 = E * (8 + 3 * s + 8) + 2 * 3 * s * V;
-    return pass1 + pass2 + pass3;
+    return form ? form_force_bytes_per_call(p.model, p.form, TrafficModel::Compulsory)
+                : force_bytes_per_call(p.model, ModelKind::FE, TrafficModel::Compulsory);
 }
 
 // $EDGEFEM_OWNER_PARTS: the owner variant's part count (default: a
