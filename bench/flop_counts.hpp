@@ -59,8 +59,10 @@ inline constexpr long kTetDeformation = 190;
 inline constexpr long kTetEnergyOnly = 23;
 // tet_force after the deformation: P = F S 45; 3 rows x (3 x (5 + 1 + 1) + 1).
 inline constexpr long kTetForceTail = 111;
-// tet_stiffness after the deformation: a_0 6, F a and S a 120, F F^T 45, 10 blocks x (aSa 5 + aa 5 + 9 x 9).
-inline constexpr long kTetStiffnessTail = 6 + 120 + 45 + 10 * (5 + 5 + 81);
+// tet_stiffness after the deformation: a_0 6, F a and S a 120, F F^T 45,
+// 10 blocks x (aSa 5 + mu aa 6 + 3 rows x (lambda Fa, mu Fa 2 + 3 entries
+// x (3 mul + 2 add) + diagonal 1)).
+inline constexpr long kTetStiffnessTail = 6 + 120 + 45 + 10 * (5 + 6 + 3 * (2 + 3 * 5 + 1));
 // tet_kx from stored blocks: 4 x (4 blocks x 3 rows x (3 mul + 3 add)) + 12 updates.
 inline constexpr long kTetKx = 4 * 4 * 3 * 6 + 12;
 

@@ -15,6 +15,7 @@
 
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/kernel_inline.hpp"
+#include "edgefem/core/xyz4.hpp"
 
 namespace edgefem {
 
@@ -355,30 +356,6 @@ EDGEFEM_KERNEL void edge_kx(const EdgeModel<S>& m, index_t e, const S* __restric
         y[3 * b + i] += k[i] * d[0] + k[3 + i] * d[1] + k[6 + i] * d[2];
     }
 }
-
-// One vertex's xyz as the first three lanes of a 4-lane vector (lane 3
-// zero), and back: two loads / stores that never touch the next vertex.
-template <class S>
-struct Xyz4 {
-    typedef S V __attribute__((vector_size(4 * sizeof(S))));
-    static V load(const S* p) {
-        V v = {p[0], p[1], p[2], S(0)};
-        return v;
-    }
-    static void store(S* p, V v) {
-        p[0] = v[0];
-        p[1] = v[1];
-        p[2] = v[2];
-    }
-    // Row r of a row-major 3x3 block as lanes 0..2 (lane 3 reads the next
-    // value: K blocks are followed by a sink block, so it is in bounds, and
-    // it only ever meets a zero lane).
-    static V row(const S* k) {
-        V v;
-        __builtin_memcpy(&v, k, sizeof v);
-        return v;
-    }
-};
 
 // K x over the segment of edges whose V0 is `a` (y(a) accumulated in
 // registers, as in edge_force_segment). Built-in scalars run it in 4-lane
