@@ -94,13 +94,50 @@ EDGEFEM_KERNEL void tet_force_scatter(const TetModel<S>& m, index_t t, const Tet
     }
 }
 
-// Forces of one tet scattered into f; returns its energy.
+// Forces of one tet scattered into f; returns its energy. Built-in
+// scalars run the same arithmetic on the columns of D, H, G, S and P as
+// 4-lane vectors (lanes = rows, lane 3 zero).
 template <class S>
 EDGEFEM_KERNEL S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict f) {
-    TetDeformation<S> def;
-    tet_deformation(m, t, u, def);
-    tet_force_scatter(m, t, def, f);
-    return def.energy;
+    if constexpr (std::is_floating_point_v<S>) {
+        using X = Xyz4<S>;
+        using V = typename X::V;
+        const auto& v = m.tet[t];
+        const auto& d = m.data[t];
+        const V u0 = X::load(&u[3 * v[0]]);
+        const V D[3] = {X::load(&u[3 * v[1]]) - u0, X::load(&u[3 * v[2]]) - u0, X::load(&u[3 * v[3]]) - u0};
+        V H[3];  // columns of H = D Dm^-1
+        for (int c = 0; c < 3; ++c) H[c] = D[0] * d.Dinv[0][c] + D[1] * d.Dinv[1][c] + D[2] * d.Dinv[2][c];
+        const V Hr[3] = {{H[0][0], H[1][0], H[2][0], S(0)}, {H[0][1], H[1][1], H[2][1], S(0)},
+                         {H[0][2], H[1][2], H[2][2], S(0)}};  // rows
+        V G[3];  // columns of G = (H + H^T + H^T H) / 2
+        for (int j = 0; j < 3; ++j) G[j] = S(0.5) * (H[j] + Hr[j] + Hr[0] * H[j][0] + Hr[1] * H[j][1] + Hr[2] * H[j][2]);
+        const S tr = G[0][0] + G[1][1] + G[2][2];
+        const S two_mu = 2 * d.vol_mu, ltr = d.vol_lambda * tr;
+        V Sv[3];  // columns (= rows) of the volume-scaled S
+        for (int j = 0; j < 3; ++j) {
+            Sv[j] = two_mu * G[j];
+            Sv[j][j] += ltr;
+        }
+        V P[3];  // columns of P = F S = S + H S
+        for (int j = 0; j < 3; ++j) P[j] = Sv[j] + H[0] * Sv[j][0] + H[1] * Sv[j][1] + H[2] * Sv[j][2];
+        V sum = {};
+        for (int i = 0; i < 3; ++i) {
+            const V fi = P[0] * d.Dinv[i][0] + P[1] * d.Dinv[i][1] + P[2] * d.Dinv[i][2];
+            S* fv = &f[3 * v[i + 1]];
+            X::store(fv, X::load(fv) + fi);
+            sum += fi;
+        }
+        S* f0 = &f[3 * v[0]];
+        X::store(f0, X::load(f0) - sum);
+        const V GG = G[0] * G[0] + G[1] * G[1] + G[2] * G[2];
+        return S(0.5) * d.vol_lambda * tr * tr + d.vol_mu * (GG[0] + GG[1] + GG[2]);
+    } else {
+        TetDeformation<S> def;
+        tet_deformation(m, t, u, def);
+        tet_force_scatter(m, t, def, f);
+        return def.energy;
+    }
 }
 
 // The 10 stiffness blocks of one tet from its deformation:
