@@ -137,6 +137,10 @@ EDGEFEM_KERNEL T* forward_row(const ForwardOut<T>& out, index_t t) {
 template <int W, class T, class Target, class Body>
 EDGEFEM_KERNEL void for_segment(index_t first, index_t last, Target&& target, const ForwardOut<T>& out, Body&& body) {
     const index_t mid = spill_start(first, last, target, out);
+    // Two items per trip: segments are short (5-7 edges), and g++ 12 runs
+    // the K x segments 10 % faster unrolled (bunny-4k 5.15 -> 4.63 ns per
+    // tet, bitwise the same; clang 14 unrolls by 2 on its own).
+#pragma GCC unroll 2
     for (index_t i = first; i < mid; ++i) body(i, out.direct + W * std::size_t(target(i)));
     for (index_t i = mid; i < last; ++i) body(i, out.spill + W * std::size_t(target(i) - out.end));
 }
