@@ -291,16 +291,26 @@ TEST(Colourings, ConflictFree) {
         const ResourceFn tet_w = [&](index_t t, std::vector<index_t>& out) {
             for (int k = 0; k < 4; ++k) out.push_back(nm.mesh.tets[4 * std::size_t(t) + k]);
         };
+        // A per-tet batch writes its tets' vertices, and vertex 0 for a padding lane.
+        const ResourceFn tet_batch_w = [&](index_t b, std::vector<index_t>& out) {
+            for (int l = 0; l < kTetBatchLanes; ++l) {
+                const index_t t = models.tet.batch_tet(b, l);
+                if (t >= models.tet.num_tets()) out.push_back(0);
+                else tet_w(t, out);
+            }
+        };
         for (index_t block : {1, 4, 32}) {
             ColouringOptions o;
             o.block = block;
             const Colouring ce = colour_edges(m, o), ct = colour_tsep_strain(m, o), cs = colour_tsep_stiffness(m, o),
-                            cq = colour_tets(models.tet, o), cv = colour_vertex_segments(m, o);
+                            cq = colour_tets(models.tet, o), cv = colour_vertex_segments(m, o),
+                            cb = colour_tet_batches(models.tet, o);
             EXPECT_EQ(colouring_conflicts(ce, m.num_vertices, edge_w), 0) << nm.name;
             EXPECT_EQ(colouring_conflicts(cv, m.num_vertices, seg_w), 0) << nm.name;
             EXPECT_EQ(colouring_conflicts(ct, m.num_edges(), tsep_w), 0) << nm.name;
             EXPECT_EQ(colouring_conflicts(cs, m.num_edges(), stiff_w), 0) << nm.name;
             EXPECT_EQ(colouring_conflicts(cq, nm.mesh.num_vertices(), tet_w), 0) << nm.name;
+            EXPECT_EQ(colouring_conflicts(cb, nm.mesh.num_vertices(), tet_batch_w), 0) << nm.name;
             if (block == 1) {
                 // Balanced: no colour more than a few times the mean (greedy alone leaves long tails).
                 for (const Colouring* c : {&ce, &ct, &cs, &cq}) {

@@ -256,6 +256,14 @@ ResourceFn tet_scatter_resources(const TetModel<S>& m) {
     };
 }
 
+template <class S>
+ResourceFn tet_batch_scatter_resources(const TetModel<S>& m) {
+    return [&m](index_t b, std::vector<index_t>& out) {
+        for (int k = 0; k < 4; ++k)
+            for (int l = 0; l < kTetBatchLanes; ++l) out.push_back(m.batches[b].v[k][l]);
+    };
+}
+
 std::vector<index_t> units_from_vertex_parts(std::span<const index_t> item_first, std::span<const index_t> part_first) {
     if (item_first.empty() || item_first.front() != 0)
         throw InvalidArgument("units_from_vertex_parts: item offsets must start at 0");
@@ -283,5 +291,7 @@ template ResourceFn tsep_stiffness_resources(const EdgeModel<double>&);
 template ResourceFn tsep_stiffness_resources(const EdgeModel<float>&);
 template ResourceFn tet_scatter_resources(const TetModel<double>&);
 template ResourceFn tet_scatter_resources(const TetModel<float>&);
+template ResourceFn tet_batch_scatter_resources(const TetModel<double>&);
+template ResourceFn tet_batch_scatter_resources(const TetModel<float>&);
 
 }  // namespace edgefem

@@ -197,7 +197,7 @@ ColouringReport colouring_report(const Mesh& mesh, const PlanOptions& opts) {
     r.edges = colour_vertex_segments(m, resolved_vertex_colouring(opts.vertex_colouring, m.num_vertices)).stats();
     r.tsep_strain = colour_tsep_strain(m, opts.segment_colouring).stats();
     r.tsep_stiffness = colour_tsep_stiffness(m, opts.segment_colouring).stats();
-    r.tets = colour_tets(make_tet_model<double>(mesh, mat), opts.tet_colouring).stats();
+    r.tets = colour_tet_batches(make_tet_model<double>(mesh, mat), opts.tet_colouring).stats();
     return r;
 }
 

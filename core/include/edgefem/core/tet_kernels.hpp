@@ -9,23 +9,11 @@
 #include <vector>
 
 #include "edgefem/core/kernel_inline.hpp"
+#include "edgefem/core/tet_batch_kernels.hpp"
 #include "edgefem/core/tet_model.hpp"
 #include "edgefem/core/xyz4.hpp"
 
 namespace edgefem {
-
-// Per-tet stiffness: the 10 distinct 3x3 blocks K_ab, a <= b, in the order
-// (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3), row-major.
-template <class S>
-struct TetStiffness {
-    std::vector<S> K;  // 90 #T
-};
-
-inline constexpr int tet_block_index(int a, int b) {
-    // a <= b
-    constexpr int start[4] = {0, 4, 7, 9};
-    return start[a] + (b - a);
-}
 
 namespace kernel {
 
@@ -94,60 +82,21 @@ EDGEFEM_KERNEL void tet_force_scatter(const TetModel<S>& m, index_t t, const Tet
     }
 }
 
-// Forces of one tet scattered into f; returns its energy. Built-in
-// scalars run the same arithmetic on the columns of D, H, G, S and P as
-// 4-lane vectors (lanes = rows, lane 3 zero).
+// Forces of one tet scattered into f; returns its energy. (Built-in
+// scalars run the batched form, tet_batch_kernels.hpp, in the loops.)
 template <class S>
 EDGEFEM_KERNEL S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict f) {
-    if constexpr (std::is_floating_point_v<S>) {
-        using X = Xyz4<S>;
-        using V = typename X::V;
-        const auto& v = m.tet[t];
-        const auto& d = m.data[t];
-        const V u0 = X::load(&u[3 * v[0]]);
-        const V D[3] = {X::load(&u[3 * v[1]]) - u0, X::load(&u[3 * v[2]]) - u0, X::load(&u[3 * v[3]]) - u0};
-        V H[3];  // columns of H = D Dm^-1
-        for (int c = 0; c < 3; ++c) H[c] = D[0] * d.Dinv[0][c] + D[1] * d.Dinv[1][c] + D[2] * d.Dinv[2][c];
-        const V Hr[3] = {{H[0][0], H[1][0], H[2][0], S(0)}, {H[0][1], H[1][1], H[2][1], S(0)},
-                         {H[0][2], H[1][2], H[2][2], S(0)}};  // rows
-        V G[3];  // columns of G = (H + H^T + H^T H) / 2
-        for (int j = 0; j < 3; ++j) G[j] = S(0.5) * (H[j] + Hr[j] + Hr[0] * H[j][0] + Hr[1] * H[j][1] + Hr[2] * H[j][2]);
-        const S tr = G[0][0] + G[1][1] + G[2][2];
-        const S two_mu = 2 * d.vol_mu, ltr = d.vol_lambda * tr;
-        V Sv[3];  // columns (= rows) of the volume-scaled S
-        for (int j = 0; j < 3; ++j) {
-            Sv[j] = two_mu * G[j];
-            Sv[j][j] += ltr;
-        }
-        V P[3];  // columns of P = F S = S + H S
-        for (int j = 0; j < 3; ++j) P[j] = Sv[j] + H[0] * Sv[j][0] + H[1] * Sv[j][1] + H[2] * Sv[j][2];
-        V sum = {};
-        for (int i = 0; i < 3; ++i) {
-            const V fi = P[0] * d.Dinv[i][0] + P[1] * d.Dinv[i][1] + P[2] * d.Dinv[i][2];
-            S* fv = &f[3 * v[i + 1]];
-            X::store(fv, X::load(fv) + fi);
-            sum += fi;
-        }
-        S* f0 = &f[3 * v[0]];
-        X::store(f0, X::load(f0) - sum);
-        const V GG = G[0] * G[0] + G[1] * G[1] + G[2] * G[2];
-        return S(0.5) * d.vol_lambda * tr * tr + d.vol_mu * (GG[0] + GG[1] + GG[2]);
-    } else {
-        TetDeformation<S> def;
-        tet_deformation(m, t, u, def);
-        tet_force_scatter(m, t, def, f);
-        return def.energy;
-    }
+    TetDeformation<S> def;
+    tet_deformation(m, t, u, def);
+    tet_force_scatter(m, t, def, f);
+    return def.energy;
 }
 
 // The 10 stiffness blocks of one tet from its deformation:
 // K_ab = (a_a . S a_b) I + lambda (F a_a)(F a_b)^T + mu (a_a . a_b) F F^T + mu (F a_b)(F a_a)^T
 // (all volume-scaled), from dP = dF S + F dS with dS = lambda tr(dG) I + 2 mu dG.
-// Built-in scalars compute each block row as one 4-lane vector (g++ 12
-// leaves the scalar form scalar: 108 against 78 ns per tet on bunny-4k for
-// clang 14's vectorised build of it); both forms do the same arithmetic per
-// entry: (mu aa) FFt_rc + (lambda Fa_ir) Fa_jc + (mu Fa_jr) Fa_ic, + aSa on
-// the diagonal.
+// Per entry: (mu aa) FFt_rc + (lambda Fa_ir) Fa_jc + (mu Fa_jr) Fa_ic, + aSa
+// on the diagonal. (Built-in scalars run the batched form in the loops.)
 template <class S>
 EDGEFEM_KERNEL void tet_stiffness_blocks(const TetData<S>& d, const TetDeformation<S>& def, S* __restrict Kt) {
     S a[4][3];
@@ -155,62 +104,26 @@ EDGEFEM_KERNEL void tet_stiffness_blocks(const TetData<S>& d, const TetDeformati
     // Material constants without the volume: Sv already carries it, and
     // vol_lambda / vol_mu carry it for the other terms.
     const S L = d.vol_lambda, M = d.vol_mu;
-    if constexpr (std::is_floating_point_v<S>) {
-        using X = Xyz4<S>;
-        using V = typename X::V;
-        const auto& F = def.F;
-        const auto& Sv = def.Sv;
-        const V Fc[3] = {{F[0][0], F[1][0], F[2][0], S(0)}, {F[0][1], F[1][1], F[2][1], S(0)}, {F[0][2], F[1][2], F[2][2], S(0)}};
-        const V Sc[3] = {{Sv[0][0], Sv[1][0], Sv[2][0], S(0)}, {Sv[0][1], Sv[1][1], Sv[2][1], S(0)},
-                         {Sv[0][2], Sv[1][2], Sv[2][2], S(0)}};
-        V Fa[4], Sa[4], FFt[3];
-        for (int i = 0; i < 4; ++i) {
-            Fa[i] = Fc[0] * a[i][0] + Fc[1] * a[i][1] + Fc[2] * a[i][2];
-            Sa[i] = Sc[0] * a[i][0] + Sc[1] * a[i][1] + Sc[2] * a[i][2];
+    S Fa[4][3], Sa[4][3], FFt[3][3];
+    for (int i = 0; i < 4; ++i)
+        for (int r = 0; r < 3; ++r) {
+            Fa[i][r] = def.F[r][0] * a[i][0] + def.F[r][1] * a[i][1] + def.F[r][2] * a[i][2];
+            Sa[i][r] = def.Sv[r][0] * a[i][0] + def.Sv[r][1] * a[i][1] + def.Sv[r][2] * a[i][2];
         }
-        for (int r = 0; r < 3; ++r) FFt[r] = Fc[0] * F[r][0] + Fc[1] * F[r][1] + Fc[2] * F[r][2];
-#pragma GCC unroll 4
-        for (int i = 0; i < 4; ++i)
-#pragma GCC unroll 4
-            for (int j = i; j < 4; ++j) {
-                const S aSa = a[i][0] * Sa[j][0] + a[i][1] * Sa[j][1] + a[i][2] * Sa[j][2];
-                const S Maa = M * (a[i][0] * a[j][0] + a[i][1] * a[j][1] + a[i][2] * a[j][2]);
-                S* blk = &Kt[9 * tet_block_index(i, j)];
-#pragma GCC unroll 3
-                for (int r = 0; r < 3; ++r) {
-                    V row = FFt[r] * Maa + Fa[j] * (L * Fa[i][r]) + Fa[i] * (M * Fa[j][r]);
-                    row[r] += aSa;
-                    // Rows in address order, lane 3 overwritten by the next
-                    // store; the tet's last row stores 3 lanes (its lane 3
-                    // would be the next tet's).
-                    if (i == 3 && r == 2)
-                        X::store(blk + 3 * r, row);
-                    else
-                        X::put(blk + 3 * r, row);
-                }
-            }
-    } else {
-        S Fa[4][3], Sa[4][3], FFt[3][3];
-        for (int i = 0; i < 4; ++i)
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+            FFt[r][c] = def.F[r][0] * def.F[c][0] + def.F[r][1] * def.F[c][1] + def.F[r][2] * def.F[c][2];
+    for (int i = 0; i < 4; ++i)
+        for (int j = i; j < 4; ++j) {
+            const S aSa = a[i][0] * Sa[j][0] + a[i][1] * Sa[j][1] + a[i][2] * Sa[j][2];
+            const S Maa = M * (a[i][0] * a[j][0] + a[i][1] * a[j][1] + a[i][2] * a[j][2]);
+            S* blk = &Kt[9 * tet_block_index(i, j)];
             for (int r = 0; r < 3; ++r) {
-                Fa[i][r] = def.F[r][0] * a[i][0] + def.F[r][1] * a[i][1] + def.F[r][2] * a[i][2];
-                Sa[i][r] = def.Sv[r][0] * a[i][0] + def.Sv[r][1] * a[i][1] + def.Sv[r][2] * a[i][2];
+                const S LFa = L * Fa[i][r], MFa = M * Fa[j][r];
+                for (int c = 0; c < 3; ++c) blk[3 * r + c] = FFt[r][c] * Maa + Fa[j][c] * LFa + Fa[i][c] * MFa;
+                blk[3 * r + r] += aSa;
             }
-        for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c)
-                FFt[r][c] = def.F[r][0] * def.F[c][0] + def.F[r][1] * def.F[c][1] + def.F[r][2] * def.F[c][2];
-        for (int i = 0; i < 4; ++i)
-            for (int j = i; j < 4; ++j) {
-                const S aSa = a[i][0] * Sa[j][0] + a[i][1] * Sa[j][1] + a[i][2] * Sa[j][2];
-                const S Maa = M * (a[i][0] * a[j][0] + a[i][1] * a[j][1] + a[i][2] * a[j][2]);
-                S* blk = &Kt[9 * tet_block_index(i, j)];
-                for (int r = 0; r < 3; ++r) {
-                    const S LFa = L * Fa[i][r], MFa = M * Fa[j][r];
-                    for (int c = 0; c < 3; ++c) blk[3 * r + c] = FFt[r][c] * Maa + Fa[j][c] * LFa + Fa[i][c] * MFa;
-                    blk[3 * r + r] += aSa;
-                }
-            }
-    }
+        }
 }
 
 // The 10 stiffness blocks of one tet at displacement u.
@@ -312,14 +225,24 @@ EDGEFEM_KERNEL void tet_kx_matrix_free(const TetModel<S>& m, index_t t, const S*
 
 // ---- Serial loops -------------------------------------------------------
 
-// f = dW/du (overwritten); returns W when `Energy`, else 0.
+// f = dW/du (overwritten); returns W when `Energy`, else 0. Built-in
+// scalars run the batches (TetModel::batches), the energy summed batch by
+// batch, lane by lane.
 template <bool Energy, class S>
 double tet_forces(const TetModel<S>& m, const S* u, S* f) {
     std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
     double W = 0;
-    for (index_t t = 0; t < m.num_tets(); ++t) {
-        const S w = kernel::tet_force(m, t, u, f);
-        if constexpr (Energy) W += double(w);
+    if constexpr (std::is_floating_point_v<S>) {
+        for (const TetBatch<S>& bt : m.batches) {
+            const auto w = kernel::batch_force<Energy>(bt, u, f);
+            if constexpr (Energy)
+                for (int l = 0; l < kTetBatchLanes; ++l) W += double(w[l]);
+        }
+    } else {
+        for (index_t t = 0; t < m.num_tets(); ++t) {
+            const S w = kernel::tet_force(m, t, u, f);
+            if constexpr (Energy) W += double(w);
+        }
     }
     return W;
 }
@@ -334,21 +257,24 @@ void tet_energies(const TetModel<S>& m, const S* u, double* energy) {
     }
 }
 
-// Conventional F+K: forces and the 12x12 stiffness of every tet. (One
-// deformation per tet for both, fused, measured no faster on bunny-4k: 106
-// against 28 + 76 ns per tet.)
-template <bool Energy, class S>
-double tet_forces_stiffness(const TetModel<S>& m, const S* u, S* f, TetStiffness<S>& K) {
-    K.K.resize(90 * std::size_t(m.num_tets()));
-    const double W = tet_forces<Energy>(m, u, f);
-    for (index_t t = 0; t < m.num_tets(); ++t) kernel::tet_stiffness(m, t, u, &K.K[90 * std::size_t(t)]);
-    return W;
-}
-
 template <class S>
 void tet_stiffness_all(const TetModel<S>& m, const S* u, TetStiffness<S>& K) {
     K.K.resize(90 * std::size_t(m.num_tets()));
-    for (index_t t = 0; t < m.num_tets(); ++t) kernel::tet_stiffness(m, t, u, &K.K[90 * std::size_t(t)]);
+    if constexpr (std::is_floating_point_v<S>) {
+        for (index_t b = 0; b < m.num_batches(); ++b) kernel::batch_stiffness(m, b, u, K.K.data());
+    } else {
+        for (index_t t = 0; t < m.num_tets(); ++t) kernel::tet_stiffness(m, t, u, &K.K[90 * std::size_t(t)]);
+    }
+}
+
+// Conventional F+K: forces and the 12x12 stiffness of every tet. (One
+// deformation per batch for both, fused, measured no faster: 51 against
+// 51-53 ns per tet on bunny-4k, 52-53 both on armadillo-7k.)
+template <bool Energy, class S>
+double tet_forces_stiffness(const TetModel<S>& m, const S* u, S* f, TetStiffness<S>& K) {
+    const double W = tet_forces<Energy>(m, u, f);
+    tet_stiffness_all(m, u, K);
+    return W;
 }
 
 // y = K x from stored per-tet blocks (overwritten).

@@ -116,6 +116,11 @@ ResourceFn tsep_stiffness_resources(const EdgeModel<S>& m);
 // Per-tet scatter: the tet's 4 vertices.
 template <class S>
 ResourceFn tet_scatter_resources(const TetModel<S>& m);
+// Per-tet batch scatter (TetModel::batches): the 16 vertices of its lanes,
+// padding lanes' vertex 0 included (they add zero to it, but a read-modify-
+// write all the same).
+template <class S>
+ResourceFn tet_batch_scatter_resources(const TetModel<S>& m);
 
 template <class S>
 Colouring colour_edges(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
@@ -136,6 +141,10 @@ Colouring colour_tsep_stiffness(const EdgeModel<S>& m, const ColouringOptions& o
 template <class S>
 Colouring colour_tets(const TetModel<S>& m, const ColouringOptions& opts = {}) {
     return colour_items(m.num_tets(), m.num_vertices, tet_scatter_resources(m), opts);
+}
+template <class S>
+Colouring colour_tet_batches(const TetModel<S>& m, const ColouringOptions& opts = {}) {
+    return colour_items(m.num_batches(), m.num_vertices, tet_batch_scatter_resources(m), opts);
 }
 
 // Units from vertex parts (partition-aware colouring). item_first[v] ..

@@ -41,8 +41,9 @@ index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const
 template <class S>
 index_t count_inverted_tets_parallel(const Executor& ex, const Mesh& mesh, const S* u);
 
-// Colour counts of the edge method's colourings for a mesh (for `edgefem
-// info` and the docs).
+// Colour counts of the edge method's colourings and the per-tet method's
+// (batches of kTetBatchLanes tets) for a mesh (for `edgefem info` and the
+// docs).
 struct ColouringReport {
     ColouringStats edges, tsep_strain, tsep_stiffness, tets;
 };

@@ -1,11 +1,13 @@
-// The per-tet kernels of core (tet_kernels.hpp) run on an Executor: the
-// stiffness is per tet (no conflicts); forces and K x scatter to the 4
-// vertices of each tet, coloured (tets of one colour share no vertex) or
+// The per-tet kernels of core (tet_kernels.hpp) run on an Executor, batch
+// by batch (TetModel::batches, as core's serial loops): the stiffness is
+// per batch (no conflicts); forces and K x scatter to the up to 16 vertices
+// of each batch's tets, coloured (batches of one colour share no vertex) or
 // into private accumulators. The per-tet method has no gather or atomic
 // workers in core: those variants run coloured (variant() says which runs).
 #pragma once
 
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "edgefem/core/executor.hpp"
@@ -18,6 +20,8 @@ namespace edgefem {
 
 template <class S>
 class ParallelTetKernels {
+    static_assert(std::is_floating_point_v<S>, "the batches exist for built-in scalars only");
+
 public:
     ParallelTetKernels(TetModel<S> model, std::shared_ptr<const Executor> executor, Variant variant,
                        const PlanOptions& opts = {})
@@ -27,7 +31,7 @@ public:
           range_chunk_(std::max<index_t>(1, opts.range_chunk)),
           parts_(std::max(1, ex_->threads())) {
         if (variant_ == Variant::Colour) {
-            col_ = colour_tets(m_, opts.tet_colouring);
+            col_ = colour_tet_batches(m_, opts.tet_colouring);
             partial_.resize(col_.num_chunks());
         }
     }
@@ -44,9 +48,10 @@ public:
         if (variant_ == Variant::Colour) {
             par::for_range(*ex_, index_t(nf), par::range_chunk(index_t(nf), range_chunk_), [&](index_t b, index_t e) { std::fill(f + b, f + e, S(0)); });
             std::fill(partial_.begin(), partial_.end(), 0.0);
-            par::for_colours(*ex_, col_, [&](index_t t, index_t chunk) {
-                const S w = kernel::tet_force(m, t, u, f);
-                if constexpr (Energy) partial_[chunk] += double(w);
+            par::for_colours(*ex_, col_, [&](index_t b, index_t chunk) {
+                const auto w = kernel::batch_force<Energy>(m.batches[b], u, f);
+                if constexpr (Energy)
+                    for (int l = 0; l < kTetBatchLanes; ++l) partial_[chunk] += double(w[l]);
             });
             double W = 0;
             if constexpr (Energy)
@@ -58,9 +63,10 @@ public:
         ex_->for_chunks(parts_, [&](index_t p) {
             S* fp = &pf_[std::size_t(p) * nf];
             double W = 0;
-            for (index_t t = par::part_begin(m.num_tets(), parts_, p); t < par::part_begin(m.num_tets(), parts_, p + 1); ++t) {
-                const S w = kernel::tet_force(m, t, u, fp);
-                if constexpr (Energy) W += double(w);
+            for (index_t b = par::part_begin(m.num_batches(), parts_, p); b < par::part_begin(m.num_batches(), parts_, p + 1); ++b) {
+                const auto w = kernel::batch_force<Energy>(m.batches[b], u, fp);
+                if constexpr (Energy)
+                    for (int l = 0; l < kTetBatchLanes; ++l) W += double(w[l]);
             }
             part_energy[p] = W;
         });
@@ -70,16 +76,17 @@ public:
         return W;
     }
 
-    // As tet_stiffness_all.
+    // As tet_stiffness_all (chunks of about range_chunk / 8 tets).
     void stiffness(const S* u, TetStiffness<S>& K) const {
         K.K.resize(90 * std::size_t(m_.num_tets()));
         const auto& m = m_;
-        par::for_range(*ex_, m.num_tets(), par::range_chunk(m.num_tets(), range_chunk_ / 8 + 1), [&](index_t b, index_t e) {
-            for (index_t t = b; t < e; ++t) kernel::tet_stiffness(m, t, u, &K.K[90 * std::size_t(t)]);
+        const index_t nb = m.num_batches();
+        par::for_range(*ex_, nb, par::range_chunk(nb, range_chunk_ / (8 * kTetBatchLanes) + 1), [&](index_t b, index_t e) {
+            for (index_t q = b; q < e; ++q) kernel::batch_stiffness(m, q, u, K.K.data());
         });
     }
 
-    // As tet_multiply.
+    // As tet_multiply (per tet, over each batch's tets).
     void multiply(const TetStiffness<S>& K, const S* x, S* y) const {
         scatter(3, y, [&](index_t t, S* out) { kernel::tet_kx(m_, t, &K.K[90 * std::size_t(t)], x, out); });
     }
@@ -96,21 +103,26 @@ public:
     }
 
 private:
-    // out = sum over tets of body(t, out) with `per` values per vertex.
+    // out = sum over tets of body(t, out) with `per` values per vertex, batch
+    // by batch (the colouring's items), each batch's tets in lane order.
     template <class Body>
     void scatter(int per, S* out, Body&& body) const {
         const std::size_t n = per * std::size_t(m_.num_vertices);
+        auto batch = [&](index_t b, S* o) {
+            for (int l = 0; l < kTetBatchLanes; ++l)
+                if (const index_t t = m_.batch_tet(b, l); t < m_.num_tets()) body(t, o);
+        };
         if (variant_ == Variant::Colour) {
             par::for_range(*ex_, index_t(n), par::range_chunk(index_t(n), range_chunk_), [&](index_t b, index_t e) { std::fill(out + b, out + e, S(0)); });
-            par::for_colours(*ex_, col_, [&](index_t t, index_t) { body(t, out); });
+            par::for_colours(*ex_, col_, [&](index_t b, index_t) { batch(b, out); });
             return;
         }
         std::vector<S>& buf = per == 3 ? pf_ : pd_;
         if (buf.size() != n * parts_) buf.assign(n * parts_, S(0));
         ex_->for_chunks(parts_, [&](index_t p) {
             S* op = &buf[std::size_t(p) * n];
-            for (index_t t = par::part_begin(m_.num_tets(), parts_, p); t < par::part_begin(m_.num_tets(), parts_, p + 1); ++t)
-                body(t, op);
+            for (index_t b = par::part_begin(m_.num_batches(), parts_, p); b < par::part_begin(m_.num_batches(), parts_, p + 1); ++b)
+                batch(b, op);
         });
         reduce(buf, n, out);
     }
