@@ -52,7 +52,11 @@ inline constexpr long kTetFormStiffnessPerLane = 72 + 360 + 6 * (9 + 45 + 9);
 inline constexpr long kEdgeKx = 39;
 inline constexpr long kVertexKx = 3;
 
-// Per-tet kernels.
+// Per-tet kernels: the one-tet form (tet_kernels.hpp), which the counting
+// scalar runs. The batched form that float and double run
+// (tet_batch_kernels.hpp) skips G's lower triangle (24) and F F^T's (15)
+// and scales F a by lambda and mu once per vertex row (36): fewer FLOPs
+// than counted here.
 // tet_deformation: D 9, H = D Dm^-1 45, G 72, tr 2, S 30, F 9, G:G 18, energy 5.
 inline constexpr long kTetDeformation = 190;
 // Of which the energy (G:G 18 + energy 5): dead code when the energy is not used.
