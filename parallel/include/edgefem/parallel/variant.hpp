@@ -101,7 +101,7 @@ inline ColouringOptions form_batch_colouring() {
 struct PlanOptions {
     ColouringOptions vertex_colouring = blocked_vertex_colouring();  // edge scatter by vertex segment (forces, K x, diagonal)
     ColouringOptions segment_colouring = blocked_colouring();  // TSEP segments (g, K)
-    ColouringOptions tet_colouring;      // per-tet scatter (items: TetModel::batches)
+    ColouringOptions tet_colouring = form_batch_colouring();  // per-tet scatter (items: TetModel::batches; units of 8)
     // FE stiffness from the tet-local form (default) or the TSEP list, and
     // the colouring of the form's batches (kTetLanes tets; units of 8 batches).
     StiffnessLayout stiffness_layout = StiffnessLayout::TetLocal;
