@@ -6,12 +6,11 @@
 #pragma once
 
 #include <algorithm>
-#include <thread>
 #include <vector>
 
-namespace edgefem::test {
+#include "edgefem/parallel/executors.hpp"
 
-inline int hardware_threads() { return int(std::max(1u, std::thread::hardware_concurrency())); }
+namespace edgefem::test {
 
 inline const std::vector<int>& test_thread_counts() {
     static const std::vector<int> counts = [] {

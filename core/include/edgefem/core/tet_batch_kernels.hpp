@@ -1,6 +1,6 @@
 // The per-tet force and stiffness for the 4 tets of a TetBatch at once, one
 // tet per SIMD lane: the arithmetic of kernel::tet_force and
-// tet_stiffness_blocks with every scalar a 4-lane vector (built-in scalars
+// tet_stiffness with every scalar a 4-lane vector (built-in scalars
 // only). Within one tet only 3 of 4 lanes ever did work, and the 3x3
 // products needed lane shuffles; across tets every lane works and none does.
 // Prototype, bunny-4k, double, 1 thread: force 26.1 -> 11.1 ns per tet.
@@ -129,7 +129,7 @@ EDGEFEM_KERNEL void transpose4(V v0, V v1, V v2, V v3, V (&out)[4]) {
 }
 
 // The terms of a batch's stiffness values, with the arithmetic of
-// tet_stiffness_blocks per entry: (mu aa) FFt_rc + (lambda Fa_ir) Fa_jc +
+// tet_stiffness per entry: (mu aa) FFt_rc + (lambda Fa_ir) Fa_jc +
 // (mu Fa_jr) Fa_ic, + aSa on the diagonal.
 template <class S>
 struct BatchStiffnessTerms {

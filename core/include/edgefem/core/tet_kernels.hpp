@@ -62,9 +62,12 @@ EDGEFEM_KERNEL void tet_grads(const TetData<S>& d, S a[4][3]) {
     }
 }
 
-// Forces of one tet from its deformation, scattered into f.
+// Forces of one tet scattered into f; returns its energy. (Built-in
+// scalars run the batched form, tet_batch_kernels.hpp, in the loops.)
 template <class S>
-EDGEFEM_KERNEL void tet_force_scatter(const TetModel<S>& m, index_t t, const TetDeformation<S>& def, S* __restrict f) {
+EDGEFEM_KERNEL S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict f) {
+    TetDeformation<S> def;
+    tet_deformation(m, t, u, def);
     S P[3][3];
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
@@ -80,25 +83,19 @@ EDGEFEM_KERNEL void tet_force_scatter(const TetModel<S>& m, index_t t, const Tet
         }
         f[3 * v[0] + r] -= sum;
     }
-}
-
-// Forces of one tet scattered into f; returns its energy. (Built-in
-// scalars run the batched form, tet_batch_kernels.hpp, in the loops.)
-template <class S>
-EDGEFEM_KERNEL S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict f) {
-    TetDeformation<S> def;
-    tet_deformation(m, t, u, def);
-    tet_force_scatter(m, t, def, f);
     return def.energy;
 }
 
-// The 10 stiffness blocks of one tet from its deformation:
+// The 10 stiffness blocks of one tet at displacement u:
 // K_ab = (a_a . S a_b) I + lambda (F a_a)(F a_b)^T + mu (a_a . a_b) F F^T + mu (F a_b)(F a_a)^T
 // (all volume-scaled), from dP = dF S + F dS with dS = lambda tr(dG) I + 2 mu dG.
 // Per entry: (mu aa) FFt_rc + (lambda Fa_ir) Fa_jc + (mu Fa_jr) Fa_ic, + aSa
 // on the diagonal. (Built-in scalars run the batched form in the loops.)
 template <class S>
-EDGEFEM_KERNEL void tet_stiffness_blocks(const TetData<S>& d, const TetDeformation<S>& def, S* __restrict Kt) {
+EDGEFEM_KERNEL void tet_stiffness(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict Kt) {
+    TetDeformation<S> def;
+    tet_deformation(m, t, u, def);
+    const auto& d = m.data[t];
     S a[4][3];
     tet_grads(d, a);
     // Material constants without the volume: Sv already carries it, and
@@ -124,14 +121,6 @@ EDGEFEM_KERNEL void tet_stiffness_blocks(const TetData<S>& d, const TetDeformati
                 blk[3 * r + r] += aSa;
             }
         }
-}
-
-// The 10 stiffness blocks of one tet at displacement u.
-template <class S>
-EDGEFEM_KERNEL void tet_stiffness(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict Kt) {
-    TetDeformation<S> def;
-    tet_deformation(m, t, u, def);
-    tet_stiffness_blocks(m.data[t], def, Kt);
 }
 
 // y += K_t x for one tet from its stored blocks. Built-in scalars: each
