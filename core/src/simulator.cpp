@@ -373,7 +373,15 @@ struct Simulator<S>::Impl {
             // Indefinite A: LDLT still solves, but report it like CG would.
             const auto D = ldlt.vectorD();
             res.negative_curvature = (D.array() <= 0).any();
-            res.residual = (A * sol - rhs).norm() / std::max(rhs.norm(), 1e-300);
+            // Norms summed by hand: Eigen's reductions trip g++ 12.2's false
+            // -Wmaybe-uninitialized inside its AVX-512 code (GCC PR 105593).
+            const Eigen::VectorXd r = A * sol - rhs;
+            double rr = 0, bb = 0;
+            for (Eigen::Index i = 0; i < r.size(); ++i) {
+                rr += r[i] * r[i];
+                bb += rhs[i] * rhs[i];
+            }
+            res.residual = std::sqrt(rr) / std::max(std::sqrt(bb), 1e-300);
             res.converged = std::isfinite(res.residual) && !res.negative_curvature;
             stats.solve_ms += ms_since(t0);
             return res;
