@@ -167,6 +167,7 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("energy_drift", fmt(e_drift, 6));
     print_kv("inverted_tets", inverted_max);
     if (out.vtu) print_kv("output", (std::filesystem::path(out.dir) / (name + ".pvd")).string());
+    print_adaptive(*executor);
     print_kv("wall_s", fmt(std::chrono::duration<double>(clock::now() - t_start).count(), 6));
 }
 
@@ -192,6 +193,7 @@ void add_simulate_command(CLI::App& app) {
         ->check(int_in_range(0));
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
+    opts->exec.adaptive = "on";  // a production run: never slower for its threads
     add_exec_options(*cmd, opts->exec);
     cmd->callback([opts] { run_simulate(*opts); });
 }

@@ -46,6 +46,7 @@ void run_static(const StaticOptions& opts) {
     print_kv("residual", fmt(r.residual, 6));
     print_kv("converged", r.converged ? "true" : "false");
     print_kv("inverted_tets", sim.last_stats().inverted_tets);
+    print_adaptive(*executor);
     print_kv("wall_s", fmt(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 6));
     // The files are written either way: the last state helps to see why.
     if (!r.converged)
@@ -66,6 +67,7 @@ void add_static_command(CLI::App& app) {
     cmd->add_option("--out", opts->out, "Output file prefix")->required()->check(non_empty_path());
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
+    opts->exec.adaptive = "on";  // a production run: never slower for its threads
     add_exec_options(*cmd, opts->exec);
     cmd->callback([opts] { run_static(*opts); });
 }

@@ -17,6 +17,7 @@
 #include "edgefem/partition/permute_mesh.hpp"
 #include "edgefem/core/tet_kernels.hpp"
 #include "edgefem/core/topology.hpp"
+#include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/executors.hpp"
 
 namespace edgefem::cli {
@@ -160,12 +161,18 @@ void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required
 // ---- Execution ------------------------------------------------------------
 
 std::shared_ptr<const Executor> ExecOptions::executor() const {
-    return make_executor(parse_backend(backend), threads, parse_schedule(schedule));
+    auto ex = make_executor(parse_backend(backend), threads, parse_schedule(schedule));
+    return adaptive == "on" ? make_adaptive(std::move(ex)) : ex;
 }
 
 std::string ExecOptions::describe() const {
     if (!parallel_kernels()) return "serial";
-    return std::string(backend) + " x" + std::to_string(executor()->threads()) + ", " + variant + ", " + schedule;
+    return std::string(backend) + " x" + std::to_string(executor()->threads()) + ", " + variant + ", " + schedule +
+           (adaptive == "on" ? ", adaptive" : "");
+}
+
+void print_adaptive(const Executor& executor) {
+    if (const auto* a = dynamic_cast<const AdaptiveExecutor*>(&executor)) print_kv("adaptive", a->summary());
 }
 
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
@@ -182,6 +189,13 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
                    "data stays in its cache). Results are identical; CG's vector passes and the owner K x "
                    "are always static (docs/parallel.md)")
         ->check(CLI::IsMember({"static", "dynamic"}))
+        ->capture_default_str();
+    cmd.add_option("--adaptive", opts.adaptive,
+                   "on: each loop of the omp/tbb back-end runs on its threads only where its first calls, timed "
+                   "on the threads and on one thread alternately, ran faster there (small meshes, where a "
+                   "barrier costs more than the work it splits, go serial); off: every loop on the threads. "
+                   "Results are identical (docs/parallel.md, \"Adaptive executor\")")
+        ->check(CLI::IsMember({"on", "off"}))
         ->capture_default_str();
     if (with_variant)
         cmd.add_option("--variant", opts.variant,

@@ -98,6 +98,10 @@ struct ExecOptions {
     std::string variant = "auto";  // auto | colour | gather | atomic | private | owner (docs/parallel.md)
     bool variant_given = false;      // --variant on the command line
     std::string schedule = "dynamic";  // static | dynamic (how the kernels' chunks go to threads)
+    // on | off: each loop on the threads only where its timed first calls
+    // ran faster there (AdaptiveExecutor); a command sets its default
+    // before add_exec_options.
+    std::string adaptive = "off";
 
     // The parallel kernels run unless this is the plain serial default
     // (--backend serial without --variant: core's serial loops).
@@ -107,7 +111,10 @@ struct ExecOptions {
     std::string describe() const;
 };
 
-// Adds --backend, --threads, --schedule and (with_variant) --variant.
+// With an AdaptiveExecutor: "adaptive: k of n loops run serially".
+void print_adaptive(const Executor& executor);
+
+// Adds --backend, --threads, --schedule, --adaptive and (with_variant) --variant.
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant = true);
 
 // The elastic-model factory a simulator should use under `exec` (empty for
