@@ -31,6 +31,7 @@ thread_local bool in_fake_parallel = false;
 class FakeExecutor final : public Executor {
 public:
     explicit FakeExecutor(std::chrono::microseconds fork) : fork_(fork) {}
+    void set_fork(std::chrono::microseconds fork) { fork_ = fork; }
     int threads() const override { return 2; }
     const char* name() const override { return "fake"; }
     void for_chunks(index_t n, const std::function<void(index_t)>& body) const override {
@@ -111,10 +112,11 @@ TEST(AdaptiveExecutor, SlowForkGoesSerial) {
     EXPECT_EQ(serial_calls, 8);
     const auto sites = ex.sites();
     ASSERT_EQ(sites.size(), 1u);
-    EXPECT_TRUE(sites[0].decided && sites[0].serial);
+    EXPECT_TRUE(sites[0].decided && sites[0].faster_serial);
     EXPECT_GT(sites[0].parallel_us, 2000);
     EXPECT_EQ(sites[0].calls, 10);
-    EXPECT_EQ(ex.summary(), "1 of 1 loops run serially");
+    EXPECT_TRUE(ex.serial());
+    EXPECT_EQ(ex.summary().rfind("serial (1 of 1 loops faster serially; calls x fastest call: ", 0), 0u) << ex.summary();
 }
 
 TEST(AdaptiveExecutor, SlowCallingThreadStaysParallel) {
@@ -131,8 +133,57 @@ TEST(AdaptiveExecutor, SlowCallingThreadStaysParallel) {
     EXPECT_EQ(parallel_calls, 7);  // 3 timed serial calls, the rest parallel
     const auto sites = ex.sites();
     ASSERT_EQ(sites.size(), 1u);
-    EXPECT_TRUE(sites[0].decided && !sites[0].serial);
-    EXPECT_EQ(ex.summary(), "0 of 1 loops run serially");
+    EXPECT_TRUE(sites[0].decided && !sites[0].faster_serial);
+    EXPECT_FALSE(ex.serial());
+    EXPECT_EQ(ex.summary().rfind("threads (0 of 1 loops faster serially; calls x fastest call: ", 0), 0u) << ex.summary();
+}
+
+// One mode for all decided sites: a loop that is faster on the threads
+// still runs serially when the loops together are faster serially (the
+// sum of calls x fastest call decides).
+TEST(AdaptiveExecutor, OneModeForAllSites) {
+    const AdaptiveExecutor ex(std::make_shared<FakeExecutor>(std::chrono::microseconds(0)), 3);
+    int fast_loop_serial = 0;
+    for (int call = 0; call < 10; ++call) {
+        ex.for_chunks(2, [](index_t c) {  // serial wins by 2 ms
+            if (c == 0 && in_fake_parallel) busy(std::chrono::microseconds(2000));
+        });
+        bool here = true;
+        ex.for_chunks(3, [&](index_t c) {  // threads win by 1 ms
+            if (c == 0 && !in_fake_parallel) busy(std::chrono::microseconds(1000));
+            here = here && !in_fake_parallel;
+        });
+        fast_loop_serial += here && call >= 6;  // past the 3 + 3 trial calls
+    }
+    // Serial: 0 + 1 ms per call of both; threads: 2 + 0 ms.
+    EXPECT_TRUE(ex.serial()) << ex.summary();
+    EXPECT_EQ(fast_loop_serial, 4);
+    EXPECT_EQ(ex.summary().rfind("serial (1 of 2 loops faster serially", 0), 0u) << ex.summary();
+}
+
+// When the machine changes, the next round of trials follows it: serial
+// while the fork is slow, back on the threads once the calling thread is
+// the slow one (rounds after 40 calls, then 80).
+TEST(AdaptiveExecutor, RetrialFollowsTheMachine) {
+    auto fake = std::make_shared<FakeExecutor>(std::chrono::microseconds(1000));
+    const AdaptiveExecutor ex(fake, 2, 40);
+    bool slow_here = false;
+    const auto call = [&] {
+        bool here = true;
+        ex.for_chunks(2, [&](index_t c) {
+            if (c == 0 && slow_here && !in_fake_parallel) busy(std::chrono::microseconds(1000));
+            here = here && !in_fake_parallel;
+        });
+        return here;
+    };
+    for (int k = 0; k < 20; ++k) call();
+    EXPECT_TRUE(ex.serial());
+    fake->set_fork(std::chrono::microseconds(0));
+    slow_here = true;
+    for (int k = 0; k < 30; ++k) call();  // past call 41: trials again
+    EXPECT_FALSE(ex.serial()) << ex.summary();
+    EXPECT_FALSE(call());
+    EXPECT_EQ(ex.sites().at(0).rounds, 2);
 }
 
 // Distinct loops (lambda types) and chunk counts are distinct sites.
@@ -185,6 +236,7 @@ TEST(AdaptiveExecutor, SimulatorStepsBitwiseUnchanged) {
 TEST(AdaptiveExecutor, BadArguments) {
     EXPECT_THROW(AdaptiveExecutor(nullptr), InvalidArgument);
     EXPECT_THROW(AdaptiveExecutor(make_executor(Backend::OpenMP, 2), 0), InvalidArgument);
+    EXPECT_THROW(AdaptiveExecutor(make_executor(Backend::OpenMP, 2), 3, 0), InvalidArgument);
     EXPECT_THROW(make_adaptive(make_executor(Backend::OpenMP, 2), -1), InvalidArgument);
     // One thread: nothing to choose, the executor itself comes back.
     const auto serial = make_executor(Backend::Serial);

@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "edgefem/parallel/adaptive_executor.hpp"
 #include "timing.hpp"
 #include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
@@ -57,6 +58,13 @@ void print_header(const BenchOptions& opts, const Mesh& mesh) {
     print_kv("backend", opts.exec.describe());
 }
 
+// The executor's threads themselves: the barrier probe and the triad time
+// them, never an adaptive choice of the calling thread.
+const Executor& threads_of(const Executor& ex) {
+    if (const auto* a = dynamic_cast<const AdaptiveExecutor*>(&ex)) return a->inner();
+    return ex;
+}
+
 // On more than one thread, what a phase boundary costs right before and
 // after the timed calls (barrier_latency.hpp says why).
 struct BarrierProbe {
@@ -65,10 +73,10 @@ struct BarrierProbe {
     double before = 0, after = 0;
     BarrierProbe(const ExecOptions& exec, std::shared_ptr<const Executor> e)
         : ex(std::move(e)), on(exec.parallel_kernels() && ex->threads() > 1) {
-        if (on) before = phase_barrier_us(*ex);
+        if (on) before = phase_barrier_us(threads_of(*ex));
     }
     void finish() {
-        if (on) after = phase_barrier_us(*ex);
+        if (on) after = phase_barrier_us(threads_of(*ex));
     }
     void print() const {
         if (!on) return;
@@ -109,6 +117,7 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     print_kv("cg_iterations", fmt(mean_iterations, 6));
     print_kv("cg_iterations_max", *std::max_element(iterations.begin(), iterations.end()));
     probe.print();
+    print_adaptive(*ex);
 }
 
 // Bytes one call of `kernel` moves (compulsory and per-pass counts,
@@ -197,7 +206,7 @@ void run_bench(const BenchOptions& opts) {
         if (opts.stream) {
             StreamOptions so;
             so.repetitions = 3;
-            sb.push_back(measure_stream_bandwidth(*opts.exec.executor(), so));
+            sb.push_back(measure_stream_bandwidth(threads_of(*opts.exec.executor()), so));
             round_fraction.push_back(traffic.compulsory / median_of_sorted(t) / sb.back().triad);
         }
         ns.insert(ns.end(), t.begin(), t.end());

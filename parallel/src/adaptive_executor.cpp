@@ -1,7 +1,9 @@
 #include "edgefem/parallel/adaptive_executor.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cxxabi.h>
+#include <cstdio>
 #include <cstdlib>
 
 #include "edgefem/core/error.hpp"
@@ -25,8 +27,9 @@ const char* kind_name(int k) {
 
 }  // namespace
 
-AdaptiveExecutor::AdaptiveExecutor(std::shared_ptr<const Executor> inner, int trials)
-    : inner_(std::move(inner)), trials_(trials) {
+AdaptiveExecutor::AdaptiveExecutor(std::shared_ptr<const Executor> inner, int trials, std::int64_t retrial)
+    : inner_(std::move(inner)), trials_(trials), next_trials_(retrial) {
+    if (retrial < 1) throw InvalidArgument("AdaptiveExecutor: retrial must be at least 1 call, got " + std::to_string(retrial));
     if (!inner_) throw InvalidArgument("AdaptiveExecutor: no executor to wrap");
     if (trials_ < 1) throw InvalidArgument("AdaptiveExecutor: trials must be at least 1, got " + std::to_string(trials));
 }
@@ -39,26 +42,48 @@ std::size_t AdaptiveExecutor::KeyHash::operator()(const Key& k) const {
 }
 
 // Trial calls alternate parallel, serial, parallel, ... until each mode has
-// `trials_` timed calls; then the mode of the fastest call wins for good.
+// `trials_` timed calls; then the site runs in the mode of all decided sites.
 int AdaptiveExecutor::pick(const Key& key, bool& time) const {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (++since_trials_ > next_trials_) {  // another round of trials for every site
+        since_trials_ = 0;
+        next_trials_ = std::max(next_trials_, std::min(2 * next_trials_, std::int64_t(1) << 22));
+        for (auto& [k, st] : stats_) {
+            st.decided = false;
+            st.timed[0] = st.timed[1] = 0;
+        }
+    }
     Stats& s = stats_[key];
     ++s.calls;
-    if (s.choice >= 0) {
-        time = false;
-        return s.choice;
-    }
-    time = true;
+    time = !s.decided;
+    if (s.decided) return mode_;
     return s.timed[1] <= s.timed[0] ? 1 : 0;
+}
+
+void AdaptiveExecutor::weighted_totals(double (&total)[2], int& decided, int& faster_serial) const {
+    total[0] = total[1] = 0;
+    decided = faster_serial = 0;
+    for (const auto& [k, s] : stats_) {
+        if (!s.decided) continue;
+        ++decided;
+        faster_serial += s.best[0] < s.best[1];
+        for (int m : {0, 1}) total[m] += double(s.calls) * s.best[m];
+    }
 }
 
 void AdaptiveExecutor::record(const Key& key, int mode, double seconds) const {
     std::lock_guard<std::mutex> lock(mutex_);
     Stats& s = stats_[key];
-    if (s.choice >= 0) return;  // another caller of the same site decided meanwhile
+    if (s.decided) return;  // another caller of the same site finished its trials meanwhile
     if (s.timed[mode] == 0 || seconds < s.best[mode]) s.best[mode] = seconds;
     ++s.timed[mode];
-    if (s.timed[0] >= trials_ && s.timed[1] >= trials_) s.choice = s.best[0] < s.best[1] ? 0 : 1;
+    if (s.timed[0] < trials_ || s.timed[1] < trials_) return;
+    s.decided = true;
+    ++s.rounds;
+    double total[2];
+    int decided, faster_serial;
+    weighted_totals(total, decided, faster_serial);
+    mode_ = total[0] < total[1] ? 0 : 1;
 }
 
 template <class Run>
@@ -126,22 +151,32 @@ std::vector<AdaptiveExecutor::Site> AdaptiveExecutor::sites() const {
         site.chunks = k.chunks;
         site.phases = k.phases;
         site.calls = s.calls;
+        site.rounds = s.rounds;
         site.serial_us = s.best[0] * 1e6;
         site.parallel_us = s.best[1] * 1e6;
-        site.decided = s.choice >= 0;
-        site.serial = s.choice == 0;
+        site.decided = s.decided;
+        site.faster_serial = s.decided && s.best[0] < s.best[1];
         out.push_back(std::move(site));
     }
     return out;
 }
 
+bool AdaptiveExecutor::serial() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return mode_ == 0;
+}
+
 std::string AdaptiveExecutor::summary() const {
-    int decided = 0, serial = 0;
-    for (const Site& s : sites()) {
-        decided += s.decided;
-        serial += s.serial;
-    }
-    return std::to_string(serial) + " of " + std::to_string(decided) + " loops run serially";
+    std::lock_guard<std::mutex> lock(mutex_);
+    double total[2];
+    int decided, faster_serial;
+    weighted_totals(total, decided, faster_serial);
+    if (decided == 0) return "undecided (no loop past its trials)";
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "%s (%d of %d loops faster serially; calls x fastest call: %.1f ms serial against %.1f on %d threads)",
+                  mode_ == 0 ? "serial" : "threads", faster_serial, decided, total[0] * 1e3, total[1] * 1e3,
+                  inner_->threads());
+    return buf;
 }
 
 std::shared_ptr<const Executor> make_adaptive(std::shared_ptr<const Executor> inner, int trials) {

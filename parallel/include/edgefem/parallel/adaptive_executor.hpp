@@ -14,8 +14,17 @@
 // lambda in the source, plus the loop's chunk count and kind) is timed for
 // its first 2 x `trials` calls, alternately on the wrapped executor and on
 // the calling thread (its chunks in order, as the executors already do for
-// a single chunk); from then on it runs where its fastest call ran.
-//
+// a single chunk), keeping each mode's fastest call. All sites start their
+// trials together, so each mode is timed with its neighbours in the same
+// mode. Once a site has its trials, it runs in the one mode chosen for all
+// decided sites: the mode with the smaller sum over them of calls x fastest
+// call. One mode for all, not one per site: a mix was never timed, and
+// measured slower than both (each switch moves the vectors between the
+// cores' caches; docs/parallel.md, "Adaptive executor").
+// The machine may change under a long run (on a shared VM the 2-thread step
+// took 1.0 ms in one minute and 1.4 ms in the next): after `retrial`
+// calls (2^14 by default), then twice as many, ... (at most 2^22 between
+// rounds) every site goes through its trials again.
 // Results never depend on the choice: the chunks are the caller's and each
 // writes only its own outputs, so the deterministic kernels (owner, colour,
 // gather, CG's blocked reductions) give bitwise the same numbers either way,
@@ -37,8 +46,10 @@ namespace edgefem {
 
 class AdaptiveExecutor final : public Executor {
 public:
-    // trials >= 1 timed calls per mode per site (InvalidArgument otherwise).
-    explicit AdaptiveExecutor(std::shared_ptr<const Executor> inner, int trials = 3);
+    // trials >= 1 timed calls per mode per site, retrial >= 1 calls before
+    // the second round of trials (InvalidArgument otherwise).
+    explicit AdaptiveExecutor(std::shared_ptr<const Executor> inner, int trials = 3,
+                              std::int64_t retrial = std::int64_t(1) << 14);
 
     int threads() const override { return inner_->threads(); }
     const char* name() const override { return inner_->name(); }
@@ -58,11 +69,17 @@ public:
         index_t chunks = 0;
         int phases = 0;
         std::int64_t calls = 0;
+        int rounds = 0;  // rounds of trials completed
         double serial_us = 0, parallel_us = 0;  // fastest timed call of each mode (0: none yet)
-        bool decided = false, serial = false;   // serial: runs on the calling thread
+        bool decided = false;    // its trials are done
+        bool faster_serial = false;  // its fastest serial call beat its fastest on the threads
     };
     std::vector<Site> sites() const;
-    // "k of n loops run serially" (n: decided sites), for reports.
+    // Whether the decided sites run on the calling thread (false before any
+    // site is decided).
+    bool serial() const;
+    // E.g. "serial (3 of 7 loops faster serially; weighted 0.41 ms serial
+    // against 0.52 on 2 threads)", for reports.
     std::string summary() const;
 
 private:
@@ -83,11 +100,14 @@ private:
         std::int64_t calls = 0;
         double best[2] = {0, 0};  // [serial, parallel], seconds; 0: not timed yet
         int timed[2] = {0, 0};
-        int8_t choice = -1;       // -1 undecided, 0 serial, 1 parallel
+        bool decided = false;
+        int rounds = 0;
     };
     // The mode of this call (0 serial, 1 parallel) and whether to time it.
     int pick(const Key& key, bool& time) const;
     void record(const Key& key, int mode, double seconds) const;
+    // Sums over the decided sites of calls x fastest call, per mode (the lock held).
+    void weighted_totals(double (&total)[2], int& decided, int& faster_serial) const;
     template <class Run>
     void dispatch(const Key& key, Run&& run) const;
 
@@ -95,6 +115,10 @@ private:
     int trials_;
     mutable std::mutex mutex_;
     mutable std::unordered_map<Key, Stats, KeyHash> stats_;
+    mutable int mode_ = 1;  // of the decided sites: 0 serial, 1 parallel
+    // Calls of decided sites since the last round of trials, and how many
+    // start the next one.
+    mutable std::int64_t since_trials_ = 0, next_trials_;
 };
 
 // `inner` wrapped in an AdaptiveExecutor when it has more than one thread;
