@@ -23,6 +23,7 @@
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/core/write_vtu.hpp"
 #ifdef EDGEFEM_PY_HAVE_PARALLEL
+#include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/parallel_operator.hpp"
 #endif
@@ -124,13 +125,16 @@ double median(const std::vector<double>& v) {
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-std::unique_ptr<Simulator<double>> make_simulator(Scene scene, const std::string& backend, int threads) {
+std::unique_ptr<Simulator<double>> make_simulator(Scene scene, const std::string& backend, int threads,
+                                                  bool adaptive) {
     if (backend == "serial") return std::make_unique<Simulator<double>>(std::move(scene));
 #ifdef EDGEFEM_PY_HAVE_PARALLEL
     auto ex = make_executor(parse_backend(backend), threads);
+    if (adaptive) ex = make_adaptive(std::move(ex));
     return std::make_unique<Simulator<double>>(std::move(scene), ex, parallel_operator_factory<double>(ex));
 #else
     (void)threads;
+    (void)adaptive;
     throw InvalidArgument("backend '" + backend + "': this build has no parallel module (use 'serial')");
 #endif
 }
@@ -374,7 +378,10 @@ PYBIND11_MODULE(edgefem, m) {
                     "Steps a Scene (double precision). displacement, velocity and external_forces are (#V, 3) "
                     "numpy views of the simulator's own state: writing into them changes the simulation.")
         .def(py::init(&make_simulator), py::arg("scene"), py::arg("backend") = "serial", py::arg("threads") = 0,
-             "backend: 'serial', or 'omp'/'tbb' when edgefem.has_parallel (threads <= 0: all).")
+             py::arg("adaptive") = true,
+             "backend: 'serial', or 'omp'/'tbb' when edgefem.has_parallel (threads <= 0: all). adaptive: the "
+             "loops run serially where their timed first calls found one thread faster (a small mesh); the "
+             "results are the same either way.")
         .def("step", &Sim::step, py::return_value_policy::copy, py::call_guard<py::gil_scoped_release>(),
              "Advances by scene.dt; raises SimulationError on failure.")
         .def(

@@ -219,3 +219,16 @@ def test_bench_forces():
     for bad in (float("inf"), float("nan"), 1e300, 0.0):
         with pytest.raises(edgefem.InvalidArgument):
             edgefem.bench_forces(small_box(), seconds=bad)
+
+
+@pytest.mark.skipif(not edgefem.has_parallel, reason="built without the parallel module")
+def test_threads_adaptive_or_not_give_the_same_steps():
+    runs = {}
+    for backend, adaptive in [("omp", True), ("omp", False), ("tbb", True)]:
+        sim = edgefem.Simulator(clamped_box_scene(6, 2, 2), backend=backend, threads=2, adaptive=adaptive)
+        sim.run(8)
+        runs[(backend, adaptive)] = sim.displacement.copy()
+    assert np.abs(runs[("omp", False)]).max() > 0
+    # deterministic kernels: bitwise the same whichever loops ran serially
+    assert (runs[("omp", True)] == runs[("omp", False)]).all()
+    assert (runs[("tbb", True)] == runs[("omp", False)]).all()
