@@ -197,6 +197,19 @@ TEST(AdaptiveExecutor, SitesByLoopAndSize) {
     EXPECT_EQ(ex.sites().size(), 3u);
 }
 
+// A caller whose chunk counts never repeat does not grow the records
+// without bound (4096 sites), and its chunks still all run.
+TEST(AdaptiveExecutor, SiteRecordsAreBounded) {
+    const AdaptiveExecutor ex(std::make_shared<FakeExecutor>(std::chrono::microseconds(0)));
+    long hits = 0, expected = 0;
+    for (index_t n = 2; n < 5002; ++n) {
+        ex.for_chunks(n, [&](index_t) { ++hits; });
+        expected += n;
+    }
+    EXPECT_EQ(hits, expected);
+    EXPECT_EQ(ex.sites().size(), 4096u);
+}
+
 // A whole simulation on the adaptive executor: bitwise the step of the
 // wrapped executor, for the deterministic variants, whatever it chose.
 TEST(AdaptiveExecutor, SimulatorStepsBitwiseUnchanged) {

@@ -41,6 +41,9 @@ std::size_t AdaptiveExecutor::KeyHash::operator()(const Key& k) const {
     return h;
 }
 
+// Sites recorded at most; a simulation has a few dozen.
+constexpr std::size_t kMaxSites = 4096;
+
 // Trial calls alternate parallel, serial, parallel, ... until each mode has
 // `trials_` timed calls; then the site runs in the mode of all decided sites.
 int AdaptiveExecutor::pick(const Key& key, bool& time) const {
@@ -53,7 +56,15 @@ int AdaptiveExecutor::pick(const Key& key, bool& time) const {
             st.timed[0] = st.timed[1] = 0;
         }
     }
-    Stats& s = stats_[key];
+    auto it = stats_.find(key);
+    if (it == stats_.end()) {
+        if (stats_.size() >= kMaxSites) {  // a caller whose chunk counts never repeat: no more records
+            time = false;
+            return mode_;
+        }
+        it = stats_.emplace(key, Stats{}).first;
+    }
+    Stats& s = it->second;
     ++s.calls;
     time = !s.decided;
     if (s.decided) return mode_;
