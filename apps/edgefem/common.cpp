@@ -191,10 +191,11 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
         ->check(CLI::IsMember({"static", "dynamic"}))
         ->capture_default_str();
     cmd.add_option("--adaptive", opts.adaptive,
-                   "on: each loop of the omp/tbb back-end runs on its threads only where its first calls, timed "
-                   "on the threads and on one thread alternately, ran faster there (small meshes, where a "
-                   "barrier costs more than the work it splits, go serial); off: every loop on the threads. "
-                   "Results are identical (docs/parallel.md, \"Adaptive executor\")")
+                   "on: the first calls of every loop of the omp/tbb back-end are timed on the threads and on one "
+                   "thread alternately, and all loops then run where they were faster in sum (small meshes, "
+                   "where a barrier costs more than the work it splits, go serial; timed again after 2^14 "
+                   "calls, then 2^15, ...); off: every loop on the threads. Results are identical "
+                   "(docs/parallel.md, Update 6)")
         ->check(CLI::IsMember({"on", "off"}))
         ->capture_default_str();
     if (with_variant)

@@ -98,8 +98,8 @@ struct ExecOptions {
     std::string variant = "auto";  // auto | colour | gather | atomic | private | owner (docs/parallel.md)
     bool variant_given = false;      // --variant on the command line
     std::string schedule = "dynamic";  // static | dynamic (how the kernels' chunks go to threads)
-    // on | off: each loop on the threads only where its timed first calls
-    // ran faster there (AdaptiveExecutor); a command sets its default
+    // on | off: the loops run serially when their timed first calls were
+    // faster so in sum (AdaptiveExecutor); a command sets its default
     // before add_exec_options.
     std::string adaptive = "off";
 
@@ -111,7 +111,7 @@ struct ExecOptions {
     std::string describe() const;
 };
 
-// With an AdaptiveExecutor: "adaptive: k of n loops run serially".
+// With an AdaptiveExecutor: "adaptive: serial|threads (...)", its verdict.
 void print_adaptive(const Executor& executor);
 
 // Adds --backend, --threads, --schedule, --adaptive and (with_variant) --variant.
