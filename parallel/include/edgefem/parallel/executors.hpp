@@ -72,9 +72,12 @@ public:
 
 private:
     void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const override;
-    // One parallel region for all phases, `omp for` (with its barrier) per phase.
+    // One parallel region for all phases, a barrier between them: spun on
+    // when the team fits the hardware threads (spin_barrier_), else
+    // OpenMP's.
     void run_phases(Schedule s, int phases, const index_t* chunk_first,
                     const std::function<void(int, index_t)>& body) const override;
+    bool spin_barrier_;
 };
 
 class TbbExecutor final : public ScheduledExecutor {
