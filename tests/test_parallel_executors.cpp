@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <thread>
 #include <vector>
 
 #include "edgefem/core/cg.hpp"
@@ -17,7 +18,7 @@
 using namespace edgefem;
 
 TEST(Executors, EveryChunkOnce) {
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB})
+    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
         for (int t : {1, 2, 3, 8})
             for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
                 const auto ex = make_executor(b, t, s);
@@ -37,7 +38,7 @@ TEST(Executors, PhasesRunOnceAndInOrder) {
     const std::vector<index_t> chunks{3, 0, 1, 16, 2, 5};
     std::vector<index_t> first{0};  // the offsets for_phases takes
     for (index_t n : chunks) first.push_back(first.back() + n);
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB})
+    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
         for (int t : {1, 2, 3, 8})
             for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
                 const auto ex = make_executor(b, t, s);
@@ -64,7 +65,7 @@ TEST(Executors, BlockedSumIndependentOfThreads) {
     std::vector<double> a(n);
     for (std::size_t i = 0; i < n; ++i) a[i] = std::sin(0.37 * double(i)) * std::exp(double(i % 97) / 7);
     const double ref = blocked_sum(SerialExecutor{}, n, [&](std::size_t i) { return a[i]; });
-    for (Backend b : {Backend::OpenMP, Backend::TBB})
+    for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
         for (int t : edgefem::test::test_thread_counts()) {
             const auto ex = make_executor(b, t);
             EXPECT_EQ(blocked_sum(*ex, n, [&](std::size_t i) { return a[i]; }), ref);
@@ -78,7 +79,7 @@ TEST(Executors, ForBlocksVisitEveryIndexOnce) {
     const std::size_t B = kVectorBlock;
     for (std::size_t n : {std::size_t(0), std::size_t(1), B - 1, B, B + 1, kMinParallelBlocks * B - 1,
                           kMinParallelBlocks * B, kMinParallelBlocks * B + 7, std::size_t(100003)})
-        for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB})
+        for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
             for (Schedule sc : {Schedule::Static, Schedule::Dynamic})
                 for (int t : {1, 2, 3, 8}) {
                     const auto ex = make_executor(b, t, sc);
@@ -145,7 +146,7 @@ TEST(Executors, ConjugateGradientSameBitsOnEveryExecutor) {
         }
     }
     EXPECT_LT(worst, 1e-9 * bmax);
-    for (Backend bk : {Backend::OpenMP, Backend::TBB})
+    for (Backend bk : {Backend::OpenMP, Backend::TBB, Backend::Pool})
         for (Schedule sc : {Schedule::Static, Schedule::Dynamic})
             for (int t : {1, 2, 3, 8}) {
                 std::vector<double> x;
@@ -159,7 +160,7 @@ TEST(Executors, ConjugateGradientSameBitsOnEveryExecutor) {
 // The barrier probe runs on every executor, and says what is wrong with
 // its arguments.
 TEST(Executors, PhaseBarrierProbe) {
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB}) {
+    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool}) {
         const auto ex = make_executor(b, 2);
         const double us = phase_barrier_us(*ex, 50, 3);
         EXPECT_TRUE(std::isfinite(us) && us >= 0) << to_string(b) << " " << us;
@@ -174,7 +175,7 @@ TEST(Executors, Names) {
     EXPECT_EQ(parse_backend("openmp"), Backend::OpenMP);
     EXPECT_EQ(parse_backend("tbb"), Backend::TBB);
     EXPECT_THROW(parse_backend("cuda"), InvalidArgument);
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB}) EXPECT_EQ(parse_backend(to_string(b)), b);
+    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool}) EXPECT_EQ(parse_backend(to_string(b)), b);
     for (Variant v : kAllVariants)
         EXPECT_EQ(parse_variant(to_string(v)), v);
     EXPECT_EQ(parse_variant("color"), Variant::Colour);
@@ -182,12 +183,14 @@ TEST(Executors, Names) {
     EXPECT_EQ(parse_schedule("static"), Schedule::Static);
     EXPECT_STREQ(make_executor(Backend::TBB, 2)->name(), "tbb");
     EXPECT_STREQ(make_executor(Backend::OpenMP, 2)->name(), "omp");
+    EXPECT_EQ(parse_backend("pool"), Backend::Pool);
+    EXPECT_STREQ(make_executor(Backend::Pool, 2)->name(), "pool");
 }
 
 // OpenMP starts as many threads as asked (1e5 crashed in libgomp): past
 // kMaxThreads both back-ends refuse; oversubscription below it is fine.
 TEST(Executors, ThreadLimit) {
-    for (Backend b : {Backend::OpenMP, Backend::TBB}) {
+    for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool}) {
         EXPECT_THROW(make_executor(b, kMaxThreads + 1), InvalidArgument) << to_string(b);
         EXPECT_THROW(make_executor(b, 100000), InvalidArgument) << to_string(b);
         EXPECT_EQ(make_executor(b, 16)->threads(), 16) << to_string(b);
@@ -201,4 +204,44 @@ TEST(Executors, IndependentArenas) {
     std::atomic<int> n{0};
     a->for_chunks(10, [&](index_t) { b->for_chunks(5, [&](index_t) { n.fetch_add(1); }); });
     EXPECT_EQ(n.load(), 50);
+}
+
+// The pool: a call from inside one of its own calls runs on the calling
+// thread (no thread waits for itself), calls from two threads at once take
+// turns, and an exception from a chunk comes back to the caller, with every
+// thread past every barrier (the pool stays usable).
+TEST(Executors, PoolNestingConcurrencyExceptions) {
+    const auto pool = make_executor(Backend::Pool, 3);
+    std::atomic<int> n{0};
+    pool->for_chunks(10, [&](index_t) { pool->for_chunks(5, [&](index_t) { n.fetch_add(1); }); });
+    EXPECT_EQ(n.load(), 50);
+    const index_t first[] = {0, 4, 9};
+    n = 0;
+    pool->for_phases(2, first, [&](int, index_t) {
+        pool->for_phases(2, first, [&](int, index_t) { n.fetch_add(1); });
+    });
+    EXPECT_EQ(n.load(), 81);
+
+    std::vector<std::atomic<int>> hits(2 * 1000);
+    const auto caller = [&](int who) {
+        for (int call = 0; call < 20; ++call)
+            pool->for_chunks(1000, [&, who](index_t c) { hits[1000 * who + c].fetch_add(1); });
+    };
+    std::thread other(caller, 1);
+    caller(0);
+    other.join();
+    for (const auto& h : hits) EXPECT_EQ(h.load(), 20);
+
+    for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
+        const auto ex = make_executor(Backend::Pool, 3, s);
+        EXPECT_THROW(ex->for_chunks(100, [](index_t c) {
+            if (c == 57) throw InvalidArgument("chunk 57");
+        }), InvalidArgument);
+        EXPECT_THROW(ex->for_phases(2, first, [](int p, index_t c) {
+            if (p == 0 && c == 1) throw InvalidArgument("phase 0 chunk 1");
+        }), InvalidArgument);
+        std::atomic<int> after{0};
+        ex->for_phases(2, first, [&](int, index_t) { after.fetch_add(1); });
+        EXPECT_EQ(after.load(), 9);
+    }
 }

@@ -44,7 +44,7 @@ struct NamedExecutor {
 const std::vector<NamedExecutor>& executors() {
     static const auto list = [] {
         std::vector<NamedExecutor> v;
-        for (Backend b : {Backend::OpenMP, Backend::TBB})
+        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
             for (int t : edgefem::test::test_thread_counts())
                 for (Schedule s : {Schedule::Dynamic, Schedule::Static}) {
                     if (s == Schedule::Static && t != 3) continue;  // one static run per backend

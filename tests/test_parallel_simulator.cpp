@@ -64,7 +64,7 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
             const std::string tag = std::string(method == Method::Edge ? "edge/" : "tet/") + to_string(var);
             EXPECT_LE(rel_diff(serial.u, core.u), 1e-12) << tag;
             EXPECT_LE(rel_diff(serial.v, core.v), 1e-12) << tag;
-            for (Backend b : {Backend::OpenMP, Backend::TBB})
+            for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
                 for (int t : edgefem::test::test_thread_counts()) {
                     const auto ex = make_executor(b, t);
                     const Result par = run(method, ex, parallel_operator_factory<double>(ex, var));

@@ -277,7 +277,7 @@ TEST(PartitionColouring, VariableUnitsEqualToBlocksColourLikeBlocks) {
 
 TEST(PartitionColouring, KernelsMatchCoreAndAreBitwiseEqualAcrossThreads) {
     std::vector<std::pair<std::string, std::shared_ptr<const Executor>>> executors;
-    for (Backend b : {Backend::OpenMP, Backend::TBB})
+    for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
         for (int t : {1, 2, 3, 4}) executors.emplace_back(std::string(to_string(b)) + "-" + std::to_string(t), make_executor(b, t));
     for (const auto& pm : part_meshes()) {
         const auto models = test::make_models<double>(pm.mesh);

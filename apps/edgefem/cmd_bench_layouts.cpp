@@ -533,9 +533,9 @@ void add_bench_layouts_command(CLI::App& app) {
                     "the force-kernel storage layouts (serial, force only)")
         ->delimiter(',')
         ->check(CLI::IsMember(names));
-    cmd->add_option("--backend", opts->backends, "Comma-separated back-ends: serial, omp, tbb")
+    cmd->add_option("--backend", opts->backends, "Comma-separated back-ends: serial, omp, tbb, pool")
         ->delimiter(',')
-        ->check(CLI::IsMember({"serial", "omp", "tbb"}))
+        ->check(CLI::IsMember({"serial", "omp", "tbb", "pool"}))
         ->capture_default_str();
     cmd->add_option("--threads", opts->threads, "Comma-separated thread counts of omp/tbb (0: all hardware threads)")
         ->delimiter(',')

@@ -177,8 +177,9 @@ void print_adaptive(const Executor& executor) {
 
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
     cmd.add_option("--backend", opts.backend,
-                   "Where the kernels run: serial (core's loops), omp (OpenMP) or tbb (oneTBB)")
-        ->check(CLI::IsMember({"serial", "omp", "tbb"}))
+                   "Where the kernels run: serial (core's loops), omp (OpenMP), tbb (oneTBB) or pool (std::threads "
+                   "that spin between calls: no system call per call; docs/parallel.md, Update 6)")
+        ->check(CLI::IsMember({"serial", "omp", "tbb", "pool"}))
         ->capture_default_str();
     cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb back-end (0: all hardware threads)")
         ->check(int_in_range(0))

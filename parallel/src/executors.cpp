@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "edgefem/core/error.hpp"
+#include "team_loops.hpp"
 
 namespace edgefem {
 
@@ -24,13 +25,15 @@ Backend parse_backend(std::string_view name) {
     if (name == "serial") return Backend::Serial;
     if (name == "omp" || name == "openmp") return Backend::OpenMP;
     if (name == "tbb") return Backend::TBB;
-    throw InvalidArgument("unknown backend '" + std::string(name) + "' (expected serial, omp or tbb)");
+    if (name == "pool") return Backend::Pool;
+    throw InvalidArgument("unknown backend '" + std::string(name) + "' (expected serial, omp, tbb or pool)");
 }
 
 const char* to_string(Backend b) {
     switch (b) {
         case Backend::Serial: return "serial";
         case Backend::OpenMP: return "omp";
+        case Backend::Pool: return "pool";
         default: return "tbb";
     }
 }
@@ -50,7 +53,7 @@ int hardware_threads() {
 
 // ---- OpenMP ---------------------------------------------------------------
 
-namespace {
+namespace team {
 int checked_threads(int threads, int all) {
     if (threads > kMaxThreads)
         throw InvalidArgument("threads: " + std::to_string(threads) + " is more than the limit of " +
@@ -58,12 +61,12 @@ int checked_threads(int threads, int all) {
                               " hardware threads)");
     return threads > 0 ? threads : all;
 }
-}  // namespace
+}  // namespace team
 
 // hardware_threads() is asked once, here: it reads /sys (system calls), too
 // slow to ask at every call.
 OmpExecutor::OmpExecutor(int threads, Schedule schedule)
-    : ScheduledExecutor(checked_threads(threads, omp_get_max_threads()), schedule),
+    : ScheduledExecutor(team::checked_threads(threads, omp_get_max_threads()), schedule),
       spin_barrier_(threads_ <= hardware_threads()) {}
 
 // Every parallel region has the full team, also when a pass has fewer
@@ -72,41 +75,6 @@ OmpExecutor::OmpExecutor(int threads, Schedule schedule)
 // then 8 edge blocks) docks and wakes threads through futexes at every
 // region; on a 16-core VM that made an 8-thread force call on armadillo-7k
 // 7x slower than at 4 threads. Idle members just pass the barrier.
-
-namespace {
-
-// A thread's share of a loop's chunks: [next, end), taken one at a time
-// from the front, by its owner first and by the others once theirs are done.
-struct alignas(64) Share {
-    std::atomic<index_t> next{0};
-    index_t end = 0;
-};
-
-// The dynamic schedule: thread i of t starts on the i-th of t contiguous
-// shares, then takes what is left of the others'. Chunk grabs stay on the
-// thread's own cache line until the shares run out, and each thread works
-// on the same chunks from call to call unless the balance needs otherwise.
-// `omp for schedule(dynamic, 1)` dealt chunks out round-robin: neighbouring
-// chunks on different cores and a different core for a chunk at each call,
-// whose data then crossed between the cores (on a VM whose cores sit 0.4 µs
-// apart: bunny-50k's 2-thread force 0.41 ms against 0.29-0.30 static;
-// docs/parallel.md, Update 6).
-void fill_shares(Share* shares, int t, index_t n) {
-    for (int i = 0; i < t; ++i) {
-        shares[i].next.store(index_t(std::int64_t(n) * i / t), std::memory_order_relaxed);
-        shares[i].end = index_t(std::int64_t(n) * (i + 1) / t);
-    }
-}
-
-template <class Body>
-void work_shares(Share* shares, int t, int i, const Body& body) {
-    for (int k = 0; k < t; ++k) {
-        Share& s = shares[(i + k) % t];
-        for (index_t c; (c = s.next.fetch_add(1, std::memory_order_relaxed)) < s.end;) body(c);
-    }
-}
-
-}  // namespace
 
 void OmpExecutor::chunks(Schedule schedule, index_t n, const std::function<void(index_t)>& body) const {
     if (n <= 0) return;
@@ -119,44 +87,12 @@ void OmpExecutor::chunks(Schedule schedule, index_t n, const std::function<void(
 #pragma omp parallel for num_threads(t) schedule(static)
         for (index_t c = 0; c < n; ++c) body(c);
     } else {
-        std::vector<Share> shares(t);
-        fill_shares(shares.data(), t, n);
+        std::vector<team::Share> shares(t);
+        team::fill_shares(shares.data(), t, n);
 #pragma omp parallel num_threads(t)
-        work_shares(shares.data(), t, omp_get_thread_num(), body);
+        team::work_shares(shares.data(), t, omp_get_thread_num(), body);
     }
 }
-
-namespace {
-
-// The barrier between the phases of one parallel region: a counter and a
-// generation, spun on. libgomp's barrier ends with a futex_wake system call
-// by the last thread to arrive, every time; on a VM with page-table
-// isolation that made each phase boundary cost 1.2-1.7 µs, against
-// 0.08-0.10 for this one (docs/parallel.md, Update 6). A waiter spins,
-// then yields, so that an oversubscribed team still makes progress; it is
-// used only when the team fits the hardware threads (spin_barrier_).
-struct alignas(64) PhaseBarrier {
-    alignas(64) std::atomic<int> arrived{0};
-    alignas(64) std::atomic<int> generation{0};
-    void wait(int team) {
-        const int g = generation.load(std::memory_order_relaxed);
-        if (arrived.fetch_add(1, std::memory_order_acq_rel) == team - 1) {
-            arrived.store(0, std::memory_order_relaxed);
-            generation.store(g + 1, std::memory_order_release);
-            return;
-        }
-        for (int spins = 0; generation.load(std::memory_order_acquire) == g;) {
-            if (++spins < 4000) {
-                __builtin_ia32_pause();
-            } else {
-                std::this_thread::yield();
-                spins = 0;
-            }
-        }
-    }
-};
-
-}  // namespace
 
 void OmpExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk_first,
                              const std::function<void(int, index_t)>& body) const {
@@ -168,39 +104,19 @@ void OmpExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk
         return;
     }
     const int t = threads_;
-    const bool spin = spin_barrier_;
-    PhaseBarrier barrier;
-    // Dynamic: every phase's shares set up front, so a phase's threads start
-    // on it right after the barrier, with nothing to reset.
-    std::unique_ptr<Share[]> shares;
-    if (schedule == Schedule::Dynamic) {
-        shares.reset(new Share[std::size_t(phases) * std::size_t(t)]);
-        for (int p = 0; p < phases; ++p) fill_shares(&shares[std::size_t(p) * t], t, chunk_first[p + 1] - chunk_first[p]);
-    }
+    const bool spin = spin_barrier_;  // the team fits the hardware threads
+    team::PhaseBarrier barrier;
+    const auto shares = schedule == Schedule::Dynamic ? team::phase_shares(t, phases, chunk_first) : nullptr;
 #pragma omp parallel num_threads(t)
     {
-        const int i = omp_get_thread_num(), team = omp_get_num_threads();
-        for (int p = 0; p < phases; ++p) {
-            if (p > 0) {
-                if (spin) {
-                    barrier.wait(team);
-                } else {
-#pragma omp barrier
-                }
-            }
-            const index_t n = chunk_first[p + 1] - chunk_first[p];
-            if (schedule == Schedule::Static) {
-                // The same contiguous chunks to thread i at every call, as
-                // `omp for schedule(static)` deals them in chunks() (the
-                // first n % team threads one more), so that a thread's
-                // share of the data is the same in both.
-                const index_t q = n / team, r = n % team;
-                const index_t c0 = i * q + std::min<index_t>(i, r), c1 = c0 + q + (i < r);
-                for (index_t c = c0; c < c1; ++c) body(p, c);
+        const int team = omp_get_num_threads();
+        team::team_phases(schedule, omp_get_thread_num(), team, phases, chunk_first, shares.get(), t, [&] {
+            if (spin) {
+                barrier.wait(team);
             } else {
-                work_shares(&shares[std::size_t(p) * t], t, i, [&](index_t c) { body(p, c); });
+#pragma omp barrier
             }
-        }
+        }, body);
     }
 }
 
@@ -217,7 +133,7 @@ struct TbbExecutor::Impl {
 };
 
 TbbExecutor::TbbExecutor(int threads, Schedule schedule)
-    : ScheduledExecutor(checked_threads(threads, tbb::info::default_concurrency()), schedule),
+    : ScheduledExecutor(team::checked_threads(threads, tbb::info::default_concurrency()), schedule),
       impl_(std::make_unique<Impl>(threads_)) {}
 
 TbbExecutor::~TbbExecutor() = default;
@@ -270,6 +186,7 @@ std::shared_ptr<const Executor> make_executor(Backend backend, int threads, Sche
     switch (backend) {
         case Backend::Serial: return std::make_shared<SerialExecutor>();
         case Backend::OpenMP: return std::make_shared<OmpExecutor>(threads, schedule);
+        case Backend::Pool: return std::make_shared<PoolExecutor>(threads, schedule);
         default: return std::make_shared<TbbExecutor>(threads, schedule);
     }
 }

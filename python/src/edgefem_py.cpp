@@ -379,7 +379,7 @@ PYBIND11_MODULE(edgefem, m) {
                     "numpy views of the simulator's own state: writing into them changes the simulation.")
         .def(py::init(&make_simulator), py::arg("scene"), py::arg("backend") = "serial", py::arg("threads") = 0,
              py::arg("adaptive") = true,
-             "backend: 'serial', or 'omp'/'tbb' when edgefem.has_parallel (threads <= 0: all). adaptive: the "
+             "backend: 'serial', or 'omp'/'tbb'/'pool' when edgefem.has_parallel (threads <= 0: all). adaptive: the "
              "loops run serially when their timed first calls were faster so in sum (a small mesh); the "
              "results are the same either way.")
         .def("step", &Sim::step, py::return_value_policy::copy, py::call_guard<py::gil_scoped_release>(),

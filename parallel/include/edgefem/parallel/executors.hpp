@@ -13,15 +13,15 @@
 
 namespace edgefem {
 
-enum class Backend { Serial, OpenMP, TBB };
+enum class Backend { Serial, OpenMP, TBB, Pool };
 
 // How chunks are handed to threads. Results never depend on it (chunks are
 // fixed by the caller); it only changes load balance and overhead.
 enum class Schedule { Static, Dynamic };
 
-// "serial" | "omp" (or "openmp") | "tbb"; throws InvalidArgument otherwise.
+// "serial" | "omp" (or "openmp") | "tbb" | "pool"; throws InvalidArgument otherwise.
 Backend parse_backend(std::string_view name);
-// "serial", "omp", "tbb".
+// "serial", "omp", "tbb", "pool".
 const char* to_string(Backend b);
 Schedule parse_schedule(std::string_view name);  // "static" | "dynamic"
 const char* to_string(Schedule s);
@@ -94,6 +94,31 @@ public:
 private:
     void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const override;
     // All phases inside one arena entry, one parallel_for per phase.
+    void run_phases(Schedule s, int phases, const index_t* chunk_first,
+                    const std::function<void(int, index_t)>& body) const override;
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// A pool of threads - 1 std::threads started once, plus the calling thread.
+// Between calls the threads spin for a while before they sleep, and the
+// phases of a call are separated by a spun-on barrier, so that a call on
+// busy threads starts and ends without a system call: libgomp makes one at
+// every region start, region end and barrier (futex_wake), which cost
+// 1.2-1.7 µs each on a VM with page-table isolation (docs/parallel.md,
+// Update 6). Threads beyond the hardware threads are accepted (they spin
+// less and yield). An exception from a chunk is rethrown by the call once
+// every thread has finished (the other chunks of that call may or may not
+// have run).
+class PoolExecutor final : public ScheduledExecutor {
+public:
+    // threads <= 0: the hardware threads; more than kMaxThreads: InvalidArgument.
+    explicit PoolExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
+    ~PoolExecutor() override;
+    const char* name() const override { return "pool"; }
+
+private:
+    void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const override;
     void run_phases(Schedule s, int phases, const index_t* chunk_first,
                     const std::function<void(int, index_t)>& body) const override;
     struct Impl;

@@ -1,0 +1,168 @@
+// PoolExecutor: threads - 1 std::threads and the calling thread, woken by
+// an epoch counter they spin on between calls (then sleep on it), each call
+// ended by a count of finished threads the caller spins on. No system call
+// on the way while the threads are busy: what libgomp spends at every
+// region start, region end and barrier (executors.hpp says why it matters).
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "edgefem/parallel/executors.hpp"
+#include "team_loops.hpp"
+
+namespace edgefem {
+
+namespace {
+// Spins of an idle thread before it sleeps on the epoch (~0.1-0.3 ms), and
+// of the caller or a barrier waiter before each yield.
+constexpr int kIdleSpins = 8000;
+constexpr int kWaitSpins = 4000;
+// The pool whose job this thread is running (nested calls run inline).
+thread_local const void* tl_running = nullptr;
+}  // namespace
+
+struct PoolExecutor::Impl {
+    using Job = std::function<void(int)>;  // thread index -> its part of the call
+
+    explicit Impl(int t) : threads(t), spin(t <= hardware_threads()) {
+        workers.reserve(std::size_t(t - 1));
+        for (int i = 1; i < t; ++i) workers.emplace_back([this, i] { work(i); });
+    }
+    ~Impl() {
+        {
+            std::lock_guard<std::mutex> lock(call);
+            quit = true;
+            epoch.fetch_add(1, std::memory_order_release);
+        }
+        epoch.notify_all();
+        for (auto& w : workers) w.join();
+    }
+
+    void work(int i) {
+        std::uint32_t seen = 0;
+        for (;;) {
+            std::uint32_t e;
+            for (int spins = 0; (e = epoch.load(std::memory_order_acquire)) == seen;) {
+                if (spin && ++spins < kIdleSpins) {
+                    __builtin_ia32_pause();
+                } else {
+                    epoch.wait(seen, std::memory_order_acquire);
+                    spins = 0;
+                }
+            }
+            seen = e;
+            if (quit) return;
+            run_part(i);
+            finished.fetch_add(1, std::memory_order_release);
+        }
+    }
+
+    // Whether the calling thread is inside one of this pool's calls: a call
+    // from there would wait for itself, so it runs on the calling thread.
+    bool inside() const { return tl_running == this; }
+
+    void run_part(int i) {
+        const void* outer = tl_running;
+        tl_running = this;
+        try {
+            (*job)(i);
+        } catch (...) {
+            std::lock_guard<std::mutex> lock(error_mutex);
+            if (!error) error = std::current_exception();
+        }
+        tl_running = outer;
+    }
+
+    // One call: every thread runs job(i), the caller as thread 0.
+    void run(const Job& f) {
+        std::lock_guard<std::mutex> lock(call);  // one call at a time
+        job = &f;
+        error = nullptr;
+        finished.store(0, std::memory_order_relaxed);
+        epoch.fetch_add(1, std::memory_order_release);
+        epoch.notify_all();  // a system call only when a thread sleeps
+        run_part(0);
+        for (int spins = 0; finished.load(std::memory_order_acquire) != threads - 1;) {
+            if (++spins < kWaitSpins) {
+                __builtin_ia32_pause();
+            } else {
+                std::this_thread::yield();
+                spins = 0;
+            }
+        }
+        job = nullptr;
+        if (error) std::rethrow_exception(error);
+    }
+
+    const int threads;
+    const bool spin;  // the threads fit the hardware threads: spin while idle
+    std::vector<std::thread> workers;
+    alignas(64) std::atomic<std::uint32_t> epoch{0};
+    alignas(64) std::atomic<int> finished{0};
+    const Job* job = nullptr;
+    bool quit = false;
+    std::mutex call, error_mutex;
+    std::exception_ptr error;
+};
+
+PoolExecutor::PoolExecutor(int threads, Schedule schedule)
+    : ScheduledExecutor(team::checked_threads(threads, hardware_threads()), schedule),
+      impl_(threads_ > 1 ? std::make_unique<Impl>(threads_) : nullptr) {}
+
+PoolExecutor::~PoolExecutor() = default;
+
+void PoolExecutor::chunks(Schedule schedule, index_t n, const std::function<void(index_t)>& body) const {
+    if (n <= 0) return;
+    if (n == 1 || threads_ == 1 || impl_->inside()) {
+        for (index_t c = 0; c < n; ++c) body(c);
+        return;
+    }
+    const int t = threads_;
+    if (schedule == Schedule::Static) {
+        impl_->run([&](int i) {
+            index_t c0, c1;
+            team::static_range(n, i, t, c0, c1);
+            for (index_t c = c0; c < c1; ++c) body(c);
+        });
+    } else {
+        std::vector<team::Share> shares(t);
+        team::fill_shares(shares.data(), t, n);
+        impl_->run([&](int i) { team::work_shares(shares.data(), t, i, body); });
+    }
+}
+
+void PoolExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk_first,
+                              const std::function<void(int, index_t)>& body) const {
+    index_t widest = 0;
+    for (int p = 0; p < phases; ++p) widest = std::max(widest, chunk_first[p + 1] - chunk_first[p]);
+    if (threads_ == 1 || widest <= 1 || impl_->inside()) {
+        for (int p = 0; p < phases; ++p)
+            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
+        return;
+    }
+    const int t = threads_;
+    team::PhaseBarrier barrier;
+    const auto shares = schedule == Schedule::Dynamic ? team::phase_shares(t, phases, chunk_first) : nullptr;
+    std::atomic<bool> failed{false};
+    impl_->run([&](int i) {
+        std::exception_ptr mine;
+        const auto guarded = [&](int p, index_t c) {
+            if (failed.load(std::memory_order_relaxed)) return;
+            try {
+                body(p, c);
+            } catch (...) {
+                failed.store(true, std::memory_order_relaxed);
+                if (!mine) mine = std::current_exception();
+            }
+        };
+        team::team_phases(schedule, i, t, phases, chunk_first, shares.get(), t, [&] { barrier.wait(t); }, guarded);
+        if (mine) std::rethrow_exception(mine);
+    });
+}
+
+}  // namespace edgefem
