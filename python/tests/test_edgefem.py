@@ -224,7 +224,7 @@ def test_bench_forces():
 @pytest.mark.skipif(not edgefem.has_parallel, reason="built without the parallel module")
 def test_threads_adaptive_or_not_give_the_same_steps():
     runs = {}
-    for backend, adaptive in [("omp", True), ("omp", False), ("tbb", True)]:
+    for backend, adaptive in [("omp", True), ("omp", False), ("tbb", True), ("pool", False)]:
         sim = edgefem.Simulator(clamped_box_scene(6, 2, 2), backend=backend, threads=2, adaptive=adaptive)
         sim.run(8)
         runs[(backend, adaptive)] = sim.displacement.copy()
@@ -232,3 +232,4 @@ def test_threads_adaptive_or_not_give_the_same_steps():
     # deterministic kernels: bitwise the same whichever loops ran serially
     assert (runs[("omp", True)] == runs[("omp", False)]).all()
     assert (runs[("tbb", True)] == runs[("omp", False)]).all()
+    assert (runs[("pool", False)] == runs[("omp", False)]).all()
