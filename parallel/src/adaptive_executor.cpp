@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "edgefem/core/error.hpp"
+#include "team_loops.hpp"
 
 namespace edgefem {
 
@@ -126,19 +127,13 @@ void AdaptiveExecutor::for_uniform_chunks(index_t n, const std::function<void(in
     });
 }
 
-namespace {
-void run_phases_here(int phases, const index_t* chunk_first, const std::function<void(int, index_t)>& body) {
-    for (int p = 0; p < phases; ++p)
-        for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
-}
-}  // namespace
 
 void AdaptiveExecutor::for_phases(int phases, const index_t* chunk_first,
                                   const std::function<void(int, index_t)>& body) const {
     if (phases <= 0) return;
     dispatch(Key{body.target_type(), Kind::Phases, phases, chunk_first[phases] - chunk_first[0]}, [&](int parallel) {
         if (parallel) return inner_->for_phases(phases, chunk_first, body);
-        run_phases_here(phases, chunk_first, body);
+        team::run_phases_here(phases, chunk_first, body);
     });
 }
 
@@ -148,7 +143,7 @@ void AdaptiveExecutor::for_uniform_phases(int phases, const index_t* chunk_first
     dispatch(Key{body.target_type(), Kind::UniformPhases, phases, chunk_first[phases] - chunk_first[0]},
              [&](int parallel) {
                  if (parallel) return inner_->for_uniform_phases(phases, chunk_first, body);
-                 run_phases_here(phases, chunk_first, body);
+                 team::run_phases_here(phases, chunk_first, body);
              });
 }
 

@@ -96,13 +96,8 @@ void OmpExecutor::chunks(Schedule schedule, index_t n, const std::function<void(
 
 void OmpExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk_first,
                              const std::function<void(int, index_t)>& body) const {
-    index_t widest = 0;
-    for (int p = 0; p < phases; ++p) widest = std::max(widest, chunk_first[p + 1] - chunk_first[p]);
-    if (threads_ == 1 || widest <= 1) {
-        for (int p = 0; p < phases; ++p)
-            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
-        return;
-    }
+    if (threads_ == 1 || team::widest_phase(phases, chunk_first) <= 1)
+        return team::run_phases_here(phases, chunk_first, body);
     const int t = threads_;
     const bool spin = spin_barrier_;  // the team fits the hardware threads
     team::PhaseBarrier barrier;
@@ -158,11 +153,7 @@ void TbbExecutor::chunks(Schedule schedule, index_t n, const std::function<void(
 
 void TbbExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk_first,
                              const std::function<void(int, index_t)>& body) const {
-    if (threads_ == 1) {
-        for (int p = 0; p < phases; ++p)
-            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
-        return;
-    }
+    if (threads_ == 1) return team::run_phases_here(phases, chunk_first, body);
     impl_->arena.execute([&] {
         for (int p = 0; p < phases; ++p) {
             const index_t n = chunk_first[p + 1] - chunk_first[p];

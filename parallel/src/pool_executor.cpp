@@ -138,13 +138,8 @@ void PoolExecutor::chunks(Schedule schedule, index_t n, const std::function<void
 
 void PoolExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk_first,
                               const std::function<void(int, index_t)>& body) const {
-    index_t widest = 0;
-    for (int p = 0; p < phases; ++p) widest = std::max(widest, chunk_first[p + 1] - chunk_first[p]);
-    if (threads_ == 1 || widest <= 1 || impl_->inside()) {
-        for (int p = 0; p < phases; ++p)
-            for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
-        return;
-    }
+    if (threads_ == 1 || team::widest_phase(phases, chunk_first) <= 1 || impl_->inside())
+        return team::run_phases_here(phases, chunk_first, body);
     const int t = threads_;
     team::PhaseBarrier barrier;
     const auto shares = schedule == Schedule::Dynamic ? team::phase_shares(t, phases, chunk_first) : nullptr;

@@ -1,10 +1,12 @@
 // What each thread of a team runs for an executor's loops, shared by the
-// OpenMP and the pool executors (a private header of parallel/src).
+// OpenMP, pool, oneTBB and adaptive executors (a private header of
+// parallel/src).
 #pragma once
 
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <thread>
 
@@ -14,6 +16,20 @@ namespace edgefem::team {
 
 // `threads`, or `all` when threads <= 0; InvalidArgument above kMaxThreads.
 int checked_threads(int threads, int all);
+
+// All phases' chunks on the calling thread, in order: what every executor
+// does with one thread or nothing to share.
+inline void run_phases_here(int phases, const index_t* chunk_first, const std::function<void(int, index_t)>& body) {
+    for (int p = 0; p < phases; ++p)
+        for (index_t c = 0; c < chunk_first[p + 1] - chunk_first[p]; ++c) body(p, c);
+}
+
+// The most chunks in any phase.
+inline index_t widest_phase(int phases, const index_t* chunk_first) {
+    index_t widest = 0;
+    for (int p = 0; p < phases; ++p) widest = std::max(widest, chunk_first[p + 1] - chunk_first[p]);
+    return widest;
+}
 
 // A thread's share of a loop's chunks: [next, end), taken one at a time
 // from the front, by its owner first and by the others once theirs are done.
