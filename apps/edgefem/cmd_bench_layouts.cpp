@@ -537,11 +537,11 @@ void add_bench_layouts_command(CLI::App& app) {
         ->delimiter(',')
         ->check(CLI::IsMember({"serial", "omp", "tbb", "pool"}))
         ->capture_default_str();
-    cmd->add_option("--threads", opts->threads, "Comma-separated thread counts of omp/tbb (0: all hardware threads)")
+    cmd->add_option("--threads", opts->threads, "Comma-separated thread counts of omp/tbb/pool (0: all hardware threads)")
         ->delimiter(',')
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
-    cmd->add_option("--variant", opts->variant, "Parallel variant of omp/tbb rows (see `edgefem bench --help`)")
+    cmd->add_option("--variant", opts->variant, "Parallel variant of omp/tbb/pool rows (see `edgefem bench --help`)")
         ->check(CLI::IsMember({"auto", "colour", "color", "gather", "atomic", "private", "owner"}))
         ->capture_default_str();
     cmd->add_option("--precision", opts->precision, "Scalar type of the tet-local and tsep-list rows")

@@ -193,7 +193,7 @@ void add_simulate_command(CLI::App& app) {
         ->check(int_in_range(0));
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
-    opts->exec.adaptive = "on";  // a production run: loops that lose on the threads run serially
+    opts->exec.adaptive = "on";  // a production run: serial when that was faster in sum
     add_exec_options(*cmd, opts->exec);
     cmd->callback([opts] { run_simulate(*opts); });
 }

@@ -67,7 +67,7 @@ void add_static_command(CLI::App& app) {
     cmd->add_option("--out", opts->out, "Output file prefix")->required()->check(non_empty_path());
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->ordering);
-    opts->exec.adaptive = "on";  // a production run: loops that lose on the threads run serially
+    opts->exec.adaptive = "on";  // a production run: serial when that was faster in sum
     add_exec_options(*cmd, opts->exec);
     cmd->callback([opts] { run_static(*opts); });
 }

@@ -181,18 +181,18 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
                    "that spin between calls: no system call per call; docs/parallel.md, Update 6)")
         ->check(CLI::IsMember({"serial", "omp", "tbb", "pool"}))
         ->capture_default_str();
-    cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb back-end (0: all hardware threads)")
+    cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb/pool back-end (0: all hardware threads)")
         ->check(int_in_range(0))
         ->capture_default_str();
     cmd.add_option("--schedule", opts.schedule,
-                   "How the omp/tbb back-end hands the kernels' chunks to threads: dynamic (balances uneven "
+                   "How the omp/tbb/pool back-end hands the kernels' chunks to threads: dynamic (balances uneven "
                    "parts) or static (the same chunks to the same threads at every call, so each thread's "
                    "data stays in its cache). Results are identical; CG's vector passes and the owner K x "
                    "are always static (docs/parallel.md)")
         ->check(CLI::IsMember({"static", "dynamic"}))
         ->capture_default_str();
     cmd.add_option("--adaptive", opts.adaptive,
-                   "on: the first calls of every loop of the omp/tbb back-end are timed on the threads and on one "
+                   "on: the first calls of every loop of the omp/tbb/pool back-end are timed on the threads and on one "
                    "thread alternately, and all loops then run where they were faster in sum (small meshes, "
                    "where a barrier costs more than the work it splits, go serial; timed again after 2^14 "
                    "calls, then 2^15, ...); off: every loop on the threads. Results are identical "

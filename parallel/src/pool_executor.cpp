@@ -18,10 +18,8 @@
 namespace edgefem {
 
 namespace {
-// Spins of an idle thread before it sleeps on the epoch (~0.1-0.3 ms), and
-// of the caller or a barrier waiter before each yield.
+// Spins of an idle thread before it sleeps on the epoch (~0.1-0.3 ms).
 constexpr int kIdleSpins = 8000;
-constexpr int kWaitSpins = 4000;
 // The pool whose job this thread is running (nested calls run inline).
 thread_local const void* tl_running = nullptr;
 }  // namespace
@@ -87,14 +85,7 @@ struct PoolExecutor::Impl {
         epoch.fetch_add(1, std::memory_order_release);
         epoch.notify_all();  // a system call only when a thread sleeps
         run_part(0);
-        for (int spins = 0; finished.load(std::memory_order_acquire) != threads - 1;) {
-            if (++spins < kWaitSpins) {
-                __builtin_ia32_pause();
-            } else {
-                std::this_thread::yield();
-                spins = 0;
-            }
-        }
+        team::spin_until([&] { return finished.load(std::memory_order_acquire) == threads - 1; });
         job = nullptr;
         if (error) std::rethrow_exception(error);
     }

@@ -80,6 +80,20 @@ inline void static_range(index_t n, int i, int team, index_t& c0, index_t& c1) {
     c1 = c0 + q + (i < r);
 }
 
+// Spins (pause) until done() holds, yielding after every 4000 spins so that
+// an oversubscribed team still makes progress.
+template <class Done>
+void spin_until(const Done& done) {
+    for (int spins = 0; !done();) {
+        if (++spins < 4000) {
+            __builtin_ia32_pause();
+        } else {
+            std::this_thread::yield();
+            spins = 0;
+        }
+    }
+}
+
 // The barrier between the phases of one team: a counter and a generation,
 // spun on. libgomp's barrier ends with a futex_wake system call by the last
 // thread to arrive, every time; on a VM with page-table isolation that made
@@ -96,14 +110,7 @@ struct alignas(64) PhaseBarrier {
             generation.store(g + 1, std::memory_order_release);
             return;
         }
-        for (int spins = 0; generation.load(std::memory_order_acquire) == g;) {
-            if (++spins < 4000) {
-                __builtin_ia32_pause();
-            } else {
-                std::this_thread::yield();
-                spins = 0;
-            }
-        }
+        spin_until([&] { return generation.load(std::memory_order_acquire) != g; });
     }
 };
 
