@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <thread>
 #include <vector>
@@ -58,6 +59,64 @@ TEST(Executors, PhasesRunOnceAndInOrder) {
                 for (std::size_t p = 0; p < chunks.size(); ++p)
                     for (index_t c = 0; c < chunks[p]; ++c) EXPECT_EQ(hits[p][c].load(), 1) << to_string(b) << t;
             }
+}
+
+// Linked phases: every (phase, chunk) once, and no chunk starts before the
+// chunks it links to (and itself) have finished the phase before.
+TEST(Executors, LinkedPhasesHonourTheirLinks) {
+    const int phases = 4;
+    const index_t n = 7;
+    // Phase 1: chunk c needs its successor; phase 2: chunks 0..c; phase 3:
+    // out-of-range ends (clamped to the chunks).
+    std::vector<index_t> first, last;
+    for (index_t c = 0; c < n; ++c) first.push_back(c), last.push_back(std::min<index_t>(c + 1, n - 1));
+    for (index_t c = 0; c < n; ++c) first.push_back(0), last.push_back(c);
+    for (index_t c = 0; c < n; ++c) first.push_back(-5), last.push_back(n + 5);
+    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
+        for (int t : {1, 2, 3, 8}) {
+            const auto ex = make_executor(b, t);
+            for (int call = 0; call < 3; ++call) {  // the pool counts on from call to call
+                std::vector<std::atomic<int>> done(std::size_t(phases * n));
+                std::atomic<int> early{0};
+                ex->for_linked_phases(phases, n, first.data(), last.data(), [&](int p, index_t c) {
+                    if (p > 0) {
+                        const std::size_t k = std::size_t(p - 1) * n + c;
+                        const index_t lo = std::max<index_t>(0, std::min(first[k], c));
+                        const index_t hi = std::min<index_t>(n - 1, std::max(last[k], c));
+                        for (index_t d = lo; d <= hi; ++d)
+                            if (done[std::size_t(p - 1) * n + d].load() != 1) early.fetch_add(1);
+                    }
+                    volatile double x = 0;  // a little work so that calls overlap
+                    for (int i = 0; i < 2000; ++i) x = x + i;
+                    done[std::size_t(p) * n + c].fetch_add(1);
+                });
+                EXPECT_EQ(early.load(), 0) << to_string(b) << t;
+                for (const auto& d : done) EXPECT_EQ(d.load(), 1) << to_string(b) << t;
+            }
+            ex->for_linked_phases(0, n, first.data(), last.data(), [](int, index_t) { FAIL(); });
+            ex->for_linked_phases(phases, 0, first.data(), last.data(), [](int, index_t) { FAIL(); });
+        }
+}
+
+// And no barrier: on the pool and OpenMP a chunk linked only to itself goes
+// on while another chunk of the phase before still runs. Here chunk 1 of
+// phase 0 waits (at most 5 s) for chunk 0 of phase 1, which a barrier
+// would hold back until the wait timed out.
+TEST(Executors, LinkedPhasesHaveNoBarrier) {
+    const index_t first[] = {0, 1}, last[] = {0, 1};
+    for (Backend b : {Backend::OpenMP, Backend::Pool}) {
+        const auto ex = make_executor(b, 2);
+        std::atomic<bool> ran{false}, seen{false};
+        ex->for_linked_phases(2, 2, first, last, [&](int p, index_t c) {
+            if (p == 1 && c == 0) ran = true;
+            if (p == 0 && c == 1) {
+                const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+                while (!ran.load() && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+                seen = ran.load();
+            }
+        });
+        EXPECT_TRUE(seen.load()) << to_string(b);
+    }
 }
 
 TEST(Executors, BlockedSumIndependentOfThreads) {
@@ -244,4 +303,18 @@ TEST(Executors, PoolNestingConcurrencyExceptions) {
         ex->for_phases(2, first, [&](int, index_t) { after.fetch_add(1); });
         EXPECT_EQ(after.load(), 9);
     }
+    // Linked phases: inline when nested, exceptions back to the caller with
+    // no chunk left waiting, the pool usable after.
+    const index_t lf[] = {0, 0, 0, 0, 0}, ll[] = {4, 4, 4, 4, 4};
+    n = 0;
+    pool->for_linked_phases(2, 5, lf, ll, [&](int, index_t) {
+        pool->for_linked_phases(2, 5, lf, ll, [&](int, index_t) { n.fetch_add(1); });
+    });
+    EXPECT_EQ(n.load(), 100);
+    EXPECT_THROW(pool->for_linked_phases(2, 5, lf, ll, [](int p, index_t c) {
+        if (p == 0 && c == 3) throw InvalidArgument("phase 0 chunk 3");
+    }), InvalidArgument);
+    n = 0;
+    pool->for_linked_phases(2, 5, lf, ll, [&](int, index_t) { n.fetch_add(1); });
+    EXPECT_EQ(n.load(), 10);
 }

@@ -278,6 +278,25 @@ TEST(ForwardSpill, WindowsAndConsumers) {
     EXPECT_EQ(balanced_parts(std::vector<index_t>{0, 1, 2, 3, 4}, 4), (std::vector<index_t>{0, 1, 2, 3, 4}));
 }
 
+// The links of linked phases, worked out by hand from the windows: part 0's
+// window [3, 8) holds targets of parts 1 and 2, so its next phase needs
+// theirs, and parts 1 and 2 need part 0's to add its window.
+TEST(ForwardSpill, PhaseLinks) {
+    const std::vector<index_t> last{7, 1, 2, 4, 4, 5, 6, 7, 8, 9, 10, 11};
+    const ForwardSpill fs = make_forward_spill(12, std::vector<index_t>{0, 3, 6, 9, 12}, [&](index_t i) { return last[i]; });
+    ASSERT_EQ(fs.window_end, (std::vector<index_t>{8, 6, 9, 12}));
+    const PhaseLinks links = linked(fs, link_window_reads, link_incoming_adds);
+    EXPECT_EQ(links.parts, 4);
+    EXPECT_EQ(links.phases(), 3);
+    EXPECT_EQ(links.first, (std::vector<index_t>{0, 1, 2, 3, /* incoming */ 0, 0, 0, 3}));
+    EXPECT_EQ(links.last, (std::vector<index_t>{2, 1, 2, 3, /* incoming */ 0, 1, 2, 3}));
+    // Phases over another part count cannot be linked to these.
+    PhaseLinks other = links;
+    EXPECT_THROW(link_incoming_adds(other, make_forward_spill(3, std::vector<index_t>{0, 1, 3}, [](index_t i) { return i; })),
+                 InvalidArgument);
+    EXPECT_EQ(PhaseLinks{}.phases(), 0);
+}
+
 TEST(Colourings, ConflictFree) {
     for (const auto& nm : meshes()) {
         const auto models = edgefem::test::make_models<double>(nm.mesh);

@@ -22,7 +22,7 @@ std::string demangle(const char* name) {
 }
 
 const char* kind_name(int k) {
-    static const char* const names[] = {"chunks", "phases", "uniform chunks", "uniform phases"};
+    static const char* const names[] = {"chunks", "phases", "uniform chunks", "uniform phases", "linked phases"};
     return names[k];
 }
 
@@ -145,6 +145,17 @@ void AdaptiveExecutor::for_uniform_phases(int phases, const index_t* chunk_first
                  if (parallel) return inner_->for_uniform_phases(phases, chunk_first, body);
                  team::run_phases_here(phases, chunk_first, body);
              });
+}
+
+void AdaptiveExecutor::for_linked_phases(int phases, index_t chunks, const index_t* need_first,
+                                         const index_t* need_last,
+                                         const std::function<void(int, index_t)>& body) const {
+    if (phases <= 0 || chunks <= 0) return;
+    dispatch(Key{body.target_type(), Kind::LinkedPhases, phases, index_t(phases) * chunks}, [&](int parallel) {
+        if (parallel) return inner_->for_linked_phases(phases, chunks, need_first, need_last, body);
+        for (int p = 0; p < phases; ++p)
+            for (index_t c = 0; c < chunks; ++c) body(p, c);
+    });
 }
 
 std::vector<AdaptiveExecutor::Site> AdaptiveExecutor::sites() const {

@@ -1,5 +1,6 @@
 #include "edgefem/parallel/forward_spill.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "edgefem/core/error.hpp"
@@ -40,6 +41,37 @@ ForwardSpill make_forward_spill(index_t n, std::span<const index_t> part_first,
         fs.in_first[q + 1] = index_t(fs.in_part.size());
     }
     return fs;
+}
+
+namespace {
+void check_parts(PhaseLinks& links, const ForwardSpill& fs) {
+    if (links.parts != 0 && links.parts != fs.parts())
+        throw InvalidArgument("phase links: " + std::to_string(fs.parts()) + " parts where earlier phases have " +
+                              std::to_string(links.parts));
+    links.parts = fs.parts();
+}
+}  // namespace
+
+void link_window_reads(PhaseLinks& links, const ForwardSpill& fs) {
+    check_parts(links, fs);
+    for (index_t q = 0; q < fs.parts(); ++q) {
+        index_t last = q;
+        if (fs.window_end[q] > fs.part_first[q + 1]) {
+            // The part holding the window's last target: the last part starting at or before it.
+            const auto it = std::upper_bound(fs.part_first.begin(), fs.part_first.end(), fs.window_end[q] - 1);
+            last = std::max(q, index_t(it - fs.part_first.begin()) - 1);
+        }
+        links.first.push_back(q);
+        links.last.push_back(last);
+    }
+}
+
+void link_incoming_adds(PhaseLinks& links, const ForwardSpill& fs) {
+    check_parts(links, fs);
+    for (index_t q = 0; q < fs.parts(); ++q) {
+        links.first.push_back(fs.in_first[q] < fs.in_first[q + 1] ? fs.in_part[fs.in_first[q]] : q);
+        links.last.push_back(q);
+    }
 }
 
 std::vector<index_t> balanced_parts(std::span<const index_t> weight_first, index_t parts) {

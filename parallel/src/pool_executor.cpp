@@ -79,6 +79,26 @@ struct PoolExecutor::Impl {
     // One call: every thread runs job(i), the caller as thread 0.
     void run(const Job& f) {
         std::lock_guard<std::mutex> lock(call);  // one call at a time
+        run_locked(f);
+    }
+
+    // One linked-phases call: job(i, progress, base) with the chunks' phase
+    // counts, kept from call to call (no per-call allocation or reset).
+    template <class LinkedJob>
+    void run_linked(index_t chunks, int phases, const LinkedJob& f) {
+        std::lock_guard<std::mutex> lock(call);
+        if (progress_size < chunks) {
+            progress.reset(new team::ChunkProgress[std::size_t(chunks)]);
+            progress_size = chunks;
+            progress_base = 0;
+        }
+        const std::int64_t base = progress_base;
+        progress_base += phases;
+        team::ChunkProgress* pr = progress.get();
+        run_locked([&](int i) { f(i, pr, base); });
+    }
+
+    void run_locked(const Job& f) {
         job = &f;
         error = nullptr;
         finished.store(0, std::memory_order_relaxed);
@@ -99,6 +119,9 @@ struct PoolExecutor::Impl {
     bool quit = false;
     std::mutex call, error_mutex;
     std::exception_ptr error;
+    std::unique_ptr<team::ChunkProgress[]> progress;  // linked phases, guarded by `call`
+    index_t progress_size = 0;
+    std::int64_t progress_base = 0;
 };
 
 PoolExecutor::PoolExecutor(int threads, Schedule schedule)
@@ -147,6 +170,32 @@ void PoolExecutor::run_phases(Schedule schedule, int phases, const index_t* chun
             }
         };
         team::team_phases(schedule, i, t, phases, chunk_first, shares.get(), t, [&] { barrier.wait(t); }, guarded);
+        if (mine) std::rethrow_exception(mine);
+    });
+}
+
+void PoolExecutor::for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
+                                     const std::function<void(int, index_t)>& body) const {
+    if (phases <= 0 || chunks <= 0) return;
+    if (threads_ == 1 || chunks == 1 || impl_->inside()) {
+        for (int p = 0; p < phases; ++p)
+            for (index_t c = 0; c < chunks; ++c) body(p, c);
+        return;
+    }
+    const int t = threads_;
+    std::atomic<bool> failed{false};
+    impl_->run_linked(chunks, phases, [&](int i, team::ChunkProgress* progress, std::int64_t base) {
+        std::exception_ptr mine;
+        const auto guarded = [&](int p, index_t c) {
+            if (failed.load(std::memory_order_relaxed)) return;
+            try {
+                body(p, c);
+            } catch (...) {
+                failed.store(true, std::memory_order_relaxed);
+                if (!mine) mine = std::current_exception();
+            }
+        };
+        team::team_linked_phases(i, t, phases, chunks, need_first, need_last, progress, base, guarded);
         if (mine) std::rethrow_exception(mine);
     });
 }

@@ -133,4 +133,37 @@ void team_phases(Schedule schedule, int i, int team, int phases, const index_t* 
     }
 }
 
+// Linked phases (Executor::for_linked_phases): a count of the phases of a
+// chunk that have finished, on a cache line of its own (its neighbours spin
+// on it). A call counts on from `base`, so counters kept from call to call
+// need no reset: base + p once the chunk's phase p - 1 is done.
+struct alignas(64) ChunkProgress {
+    std::atomic<std::int64_t> done{0};
+};
+
+// Thread i of a team of `team`: its static range of the chunks, phase by
+// phase; before chunk c of phase p > 0 it waits for the chunks of phase p - 1
+// that c needs and that another thread runs (its own ran before). Every
+// chunk's count moves on even when body skips it (after an exception), so
+// no neighbour waits for ever.
+template <class Body>
+void team_linked_phases(int i, int team, int phases, index_t chunks, const index_t* need_first,
+                        const index_t* need_last, ChunkProgress* progress, std::int64_t base, const Body& body) {
+    index_t c0, c1;
+    static_range(chunks, i, team, c0, c1);
+    for (int p = 0; p < phases; ++p)
+        for (index_t c = c0; c < c1; ++c) {
+            if (p > 0) {
+                const std::size_t k = std::size_t(p - 1) * std::size_t(chunks) + std::size_t(c);
+                const index_t lo = std::max<index_t>(0, std::min(need_first[k], c));
+                const index_t hi = std::min<index_t>(chunks - 1, std::max(need_last[k], c));
+                for (index_t d = lo; d <= hi; ++d)
+                    if (d < c0 || d >= c1)
+                        spin_until([&] { return progress[d].done.load(std::memory_order_acquire) >= base + p; });
+            }
+            body(p, c);
+            progress[c].done.store(base + p + 1, std::memory_order_release);
+        }
+}
+
 }  // namespace edgefem::team

@@ -44,6 +44,24 @@ public:
                                     const std::function<void(int, index_t)>& body) const {
         for_phases(phases, chunk_first, body);
     }
+    // Phases over the same `chunks` chunks (the fixed parts of an owner
+    // scatter), where chunk c of phase p > 0 reads only what chunk c and
+    // chunks need_first[k] .. need_last[k] (k = (p - 1) * chunks + c) wrote
+    // in phase p - 1 and, through them, in the phases before. An executor
+    // may start it as soon as those have finished instead of waiting for
+    // the whole phase: no barrier, so one part's slow phase is not every
+    // part's wait. The caller must then also make sure that no chunk writes
+    // what a chunk of another phase, running at the same time, reads. Same
+    // calls as for_uniform_phases, which is the default (barriers satisfy
+    // every link).
+    virtual void for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
+                                   const std::function<void(int, index_t)>& body) const {
+        (void)need_first;
+        (void)need_last;
+        std::vector<index_t> first(std::size_t(std::max(phases, 0)) + 1);
+        for (std::size_t p = 0; p < first.size(); ++p) first[p] = index_t(p) * chunks;
+        for_uniform_phases(phases, first.data(), body);
+    }
 };
 
 class SerialExecutor final : public Executor {

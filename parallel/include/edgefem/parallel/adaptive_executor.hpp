@@ -61,11 +61,13 @@ public:
     void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const override;
     void for_uniform_phases(int phases, const index_t* chunk_first,
                             const std::function<void(int, index_t)>& body) const override;
+    void for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
+                           const std::function<void(int, index_t)>& body) const override;
 
     // What was measured and chosen at each call site so far.
     struct Site {
         std::string loop;  // the body's type (demangled), e.g. a lambda's enclosing function
-        std::string kind;  // "chunks", "phases", "uniform chunks", "uniform phases"
+        std::string kind;  // "chunks", "phases", "uniform chunks", "uniform phases", "linked phases"
         index_t chunks = 0;
         int phases = 0;
         std::int64_t calls = 0;
@@ -83,7 +85,7 @@ public:
     std::string summary() const;
 
 private:
-    enum class Kind : std::uint8_t { Chunks, Phases, UniformChunks, UniformPhases };
+    enum class Kind : std::uint8_t { Chunks, Phases, UniformChunks, UniformPhases, LinkedPhases };
     struct Key {
         std::type_index type;
         Kind kind;

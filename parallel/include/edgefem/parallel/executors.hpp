@@ -69,6 +69,10 @@ public:
     // threads <= 0: omp_get_max_threads(); more than kMaxThreads: InvalidArgument.
     explicit OmpExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
     const char* name() const override { return "omp"; }
+    // Linked phases on the static schedule in one parallel region: a chunk
+    // waits only for the chunks it needs, spinning on their phase counts.
+    void for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
+                           const std::function<void(int, index_t)>& body) const override;
 
 private:
     void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const override;
@@ -116,6 +120,10 @@ public:
     explicit PoolExecutor(int threads = 0, Schedule schedule = Schedule::Dynamic);
     ~PoolExecutor() override;
     const char* name() const override { return "pool"; }
+    // Linked phases on the static schedule: a chunk waits only for the
+    // chunks it needs, spinning on their phase counts.
+    void for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
+                           const std::function<void(int, index_t)>& body) const override;
 
 private:
     void chunks(Schedule s, index_t n, const std::function<void(index_t)>& body) const override;

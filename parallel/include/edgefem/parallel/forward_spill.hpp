@@ -38,6 +38,36 @@ struct ForwardSpill {
     std::size_t spill_targets() const { return window_first.empty() ? 0 : window_first.back(); }
 };
 
+// What each phase of an owner scatter over a ForwardSpill's parts needs of
+// the phase before, for Executor::for_linked_phases: per phase after the
+// first, the range of parts [first, last] whose previous phase part q
+// waits for (besides its own). With barriers every part waits for all.
+struct PhaseLinks {
+    index_t parts = 0;
+    std::vector<index_t> first, last;  // (phases - 1) * parts
+    int phases() const { return parts > 0 ? int(first.size() / std::size_t(parts)) + 1 : 0; }
+};
+
+// Appends a phase whose part q reads the targets of its window, which the
+// parts holding them (q's successors) wrote in the phase before.
+void link_window_reads(PhaseLinks& links, const ForwardSpill& fs);
+// Appends a phase whose part q adds the windows of the earlier parts that
+// reach into its range, which they wrote in the phase before.
+void link_incoming_adds(PhaseLinks& links, const ForwardSpill& fs);
+// Builds links phase by phase: linked(fs, link_window_reads, ...).
+template <class... Steps>
+PhaseLinks linked(const ForwardSpill& fs, Steps... steps) {
+    PhaseLinks links;
+    (steps(links, fs), ...);
+    return links;
+}
+
+// body(phase, part) for every phase of `links` and every part, on `ex`.
+template <class Body>
+void run_linked(const Executor& ex, const PhaseLinks& links, Body&& body) {
+    ex.for_linked_phases(links.phases(), links.parts, links.first.data(), links.last.data(), body);
+}
+
 // `last_target(i)`: the largest target item i writes (i itself when none is
 // larger). Throws InvalidArgument when part_first does not run from 0 to n
 // in non-decreasing steps or a target lies outside [i, n).
@@ -88,12 +118,12 @@ T take_incoming_spill(const ForwardSpill& fs, index_t p, index_t t, std::vector<
 // begin, end, fwd) runs items [begin, end) of the part, writing its own
 // targets in `out` and its forward targets through the kernel::ForwardOut
 // `fwd` (targets past `end` land in the part's window). `spill` must hold
-// fs.spill_targets() * W zeros; it is left zeroed.
+// fs.spill_targets() * W zeros; it is left zeroed. `links`:
+// linked(fs, link_incoming_adds), kept by the caller.
 template <int W, class T, class Body>
-void run_forward_spill(const Executor& ex, const ForwardSpill& fs, T* out, std::vector<T>& spill, Body&& body) {
-    const index_t P = fs.parts();
-    const index_t phase_first[3] = {0, P, 2 * P};
-    ex.for_uniform_phases(2, phase_first, [&](int phase, index_t p) {
+void run_forward_spill(const Executor& ex, const ForwardSpill& fs, const PhaseLinks& links, T* out,
+                       std::vector<T>& spill, Body&& body) {
+    run_linked(ex, links, [&](int phase, index_t p) {
         const index_t begin = fs.part_first[p], end = fs.part_first[p + 1];
         if (phase == 0)
             body(p, begin, end, kernel::ForwardOut<T>{out, spill.data() + W * fs.window_first[p], end});

@@ -154,6 +154,12 @@ private:
     // Owner variant: parts and spill windows (values per target: 3 for
     // forces and K x, 9 for diagonal blocks, 1 for g), kept zeroed.
     ForwardSpill vspill_, espill_;
+    // What each phase of the owner kernels waits for (run_linked): the
+    // edge and vertex scatters (forward_spill.hpp), K x (pad, segments,
+    // incoming), the forces from the TSEP list (strains, fused loop,
+    // corrections, incoming f) and from the form (as owner_form_forces),
+    // and the stiffness from the form (batches, incoming).
+    PhaseLinks vertex_links_, kx_links_, fused_links_, form_force_links_, form_stiffness_links_;
     // owner_fused_forces: per part, the edges whose g gets terms from
     // earlier parts' windows (offsets into a list).
     std::vector<index_t> corr_first_, corr_edges_;
@@ -323,6 +329,10 @@ ParallelEdgeKernels<S>::ParallelEdgeKernels(EdgeModel<S> model, std::shared_ptr<
                 spill_vertex_first_[q] = c;
             }
             spill_g_.assign(espill_.spill_targets(), 0.0);
+            vertex_links_ = linked(vspill_, link_incoming_adds);
+            kx_links_ = linked(vspill_, link_window_reads, link_incoming_adds);
+            fused_links_ = linked(espill_, link_window_reads, link_incoming_adds);
+            link_incoming_adds(fused_links_, vspill_);
             if (tet_local_stiffness()) build_owner_form_parts();
             if (opts.stiffness && !m_.target.empty()) build_stiffness_sources();
             break;
@@ -482,6 +492,9 @@ void ParallelEdgeKernels<S>::build_owner_form_parts() {
                 }
     }
     fspill_ = make_forward_spill(ne, espill_.part_first, [&reach](index_t e) { return reach[e]; });
+    form_stiffness_links_ = linked(fspill_, link_incoming_adds);
+    form_force_links_ = linked(fspill_, link_window_reads, link_incoming_adds);
+    link_incoming_adds(form_force_links_, vspill_);
     if (form_forces()) spill_fg_.assign(fspill_.spill_targets(), 0.0);
     spill_fk_.assign(9 * fspill_.spill_targets(), S(0));
     build_owner_form_tiles(form_tile_batches_);
@@ -527,9 +540,7 @@ template <class Middle>
 void ParallelEdgeKernels<S>::owner_force_phases(const S* u, S* f, EdgeState<S>& st, Middle&& middle) const {
     const auto& m = m_;
     const ForwardSpill &vs = vspill_, &es = espill_;
-    const index_t P = vs.parts();
-    const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
-    ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
+    run_linked(*ex_, fused_links_, [&](int phase, index_t q) {
         const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
         const index_t eb = es.part_first[q], ee = es.part_first[q + 1];
         if (phase == 0) {
@@ -582,10 +593,8 @@ void ParallelEdgeKernels<S>::owner_form_forces(const S* u, S* f, EdgeState<S>& s
     S* p = st.p.data();
     S* zeta = st.zeta.data();
     double* g = st.g.data();
-    const index_t P = vs.parts();
-    const index_t phase_first[5] = {0, P, 2 * P, 3 * P, 4 * P};
     const bool far = form_.tiles.size() > 1;  // core's tiles: the mesh exceeds the cache
-    ex_->for_phases(4, phase_first, [&](int phase, index_t q) {
+    run_linked(*ex_, form_force_links_, [&](int phase, index_t q) {
         const index_t vb = vs.part_first[q], ve = vs.part_first[q + 1];
         const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
         const kernel::ForwardOut<S> fout{f, spill_v_.data() + 3 * vs.window_first[q], ve};
@@ -658,10 +667,8 @@ void ParallelEdgeKernels<S>::stiffness(const EdgeState<S>& st, EdgeStiffness<S>&
         // Only the last part's last batch has padding lanes (they write the
         // sink).
         const ForwardSpill& fs = fspill_;
-        const index_t P = fs.parts();
-        const index_t phase_first[3] = {0, P, 2 * P};
         const bool far = form_.tiles.size() > 1;
-        ex_->for_phases(2, phase_first, [&](int phase, index_t q) {
+        run_linked(*ex_, form_stiffness_links_, [&](int phase, index_t q) {
             const index_t eb = fs.part_first[q], ee = fs.part_first[q + 1];
             if (phase == 0) {  // tile by tile (FormTile): the edge terms, then the batches
                 const kernel::ForwardOut<S> kout{K, spill_fk_.data() + 9 * fs.window_first[q], ee};
@@ -736,13 +743,12 @@ void ParallelEdgeKernels<S>::multiply(const EdgeStiffness<S>& Ks, const S* x, S*
             // the same as on xyz strides. armadillo-7k: 44.6 -> 37.9 us at 1
             // thread, 24.6 -> 22.0 at 2 (the third phase's barrier included).
             const ForwardSpill& vs = vspill_;
-            const index_t P = vs.parts(), nv = m.num_vertices;
+            const index_t nv = m.num_vertices;
             Ks.x4.resize(4 * std::size_t(nv));
             Ks.y4.resize(4 * std::size_t(nv));
             S* x4 = Ks.x4.data();
             S* y4 = Ks.y4.data();
-            const index_t phase_first[4] = {0, P, 2 * P, 3 * P};
-            ex_->for_uniform_phases(3, phase_first, [&](int phase, index_t q) {
+            run_linked(*ex_, kx_links_, [&](int phase, index_t q) {
                 const index_t b = vs.part_first[q], e = vs.part_first[q + 1];
                 if (phase == 0) {
                     kernel::pad_xyz(x, x4, b, e);
@@ -804,7 +810,7 @@ void ParallelEdgeKernels<S>::scatter_to_vertices(S* out, const Segment& segment,
         case Variant::Owner:
             // A part's own range is written by no other part before the
             // barrier, so it is zeroed inside the part's work.
-            run_forward_spill<3>(*ex_, vspill_, out, spill_v_, [&](index_t q, index_t b, index_t e, const auto& fwd) {
+            run_forward_spill<3>(*ex_, vspill_, vertex_links_, out, spill_v_, [&](index_t q, index_t b, index_t e, const auto& fwd) {
                 std::fill(out + 3 * std::size_t(b), out + 3 * std::size_t(e), S(0));
                 const index_t c = spill_vertex_first_[q];
                 for (index_t a = b; a < c; ++a) segment(a, out);
@@ -850,7 +856,7 @@ void ParallelEdgeKernels<S>::diagonal_blocks(const EdgeStiffness<S>& Ks, S* D) c
             break;
         }
         case Variant::Owner:
-            run_forward_spill<9>(*ex_, vspill_, D, spill_d_, [&](index_t q, index_t b, index_t e, const auto& fwd) {
+            run_forward_spill<9>(*ex_, vspill_, vertex_links_, D, spill_d_, [&](index_t q, index_t b, index_t e, const auto& fwd) {
                 std::fill(D + 9 * std::size_t(b), D + 9 * std::size_t(e), S(0));
                 const index_t c = spill_vertex_first_[q];
                 for (index_t a = b; a < c; ++a) kernel::edge_diagonal_segment(m, a, K, D);
