@@ -153,8 +153,7 @@ void AdaptiveExecutor::for_linked_phases(int phases, index_t chunks, const index
     if (phases <= 0 || chunks <= 0) return;
     dispatch(Key{body.target_type(), Kind::LinkedPhases, phases, index_t(phases) * chunks}, [&](int parallel) {
         if (parallel) return inner_->for_linked_phases(phases, chunks, need_first, need_last, body);
-        for (int p = 0; p < phases; ++p)
-            for (index_t c = 0; c < chunks; ++c) body(p, c);
+        team::run_linked_here(phases, chunks, body);
     });
 }
 

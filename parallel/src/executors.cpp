@@ -118,11 +118,7 @@ void OmpExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk
 void OmpExecutor::for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
                                     const std::function<void(int, index_t)>& body) const {
     if (phases <= 0 || chunks <= 0) return;
-    if (threads_ == 1 || chunks == 1) {
-        for (int p = 0; p < phases; ++p)
-            for (index_t c = 0; c < chunks; ++c) body(p, c);
-        return;
-    }
+    if (threads_ == 1 || chunks == 1) return team::run_linked_here(phases, chunks, body);
     // Zeroed per call: concurrent callers may share this executor.
     const std::unique_ptr<team::ChunkProgress[]> progress(new team::ChunkProgress[std::size_t(chunks)]);
 #pragma omp parallel num_threads(threads_)

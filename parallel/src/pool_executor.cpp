@@ -22,6 +22,26 @@ namespace {
 constexpr int kIdleSpins = 8000;
 // The pool whose job this thread is running (nested calls run inline).
 thread_local const void* tl_running = nullptr;
+
+// One thread's part of a phased call: run(guarded), where guarded(p, c)
+// runs body(p, c) unless a chunk of this call has thrown, so that every
+// thread still passes every barrier (or moves every chunk count on); then
+// this thread's exception, if any, is rethrown (the pool hands the first
+// one to the caller).
+template <class Run>
+void guarded_part(std::atomic<bool>& failed, const std::function<void(int, index_t)>& body, Run&& run) {
+    std::exception_ptr mine;
+    run([&](int p, index_t c) {
+        if (failed.load(std::memory_order_relaxed)) return;
+        try {
+            body(p, c);
+        } catch (...) {
+            failed.store(true, std::memory_order_relaxed);
+            if (!mine) mine = std::current_exception();
+        }
+    });
+    if (mine) std::rethrow_exception(mine);
+}
 }  // namespace
 
 struct PoolExecutor::Impl {
@@ -159,44 +179,22 @@ void PoolExecutor::run_phases(Schedule schedule, int phases, const index_t* chun
     const auto shares = schedule == Schedule::Dynamic ? team::phase_shares(t, phases, chunk_first) : nullptr;
     std::atomic<bool> failed{false};
     impl_->run([&](int i) {
-        std::exception_ptr mine;
-        const auto guarded = [&](int p, index_t c) {
-            if (failed.load(std::memory_order_relaxed)) return;
-            try {
-                body(p, c);
-            } catch (...) {
-                failed.store(true, std::memory_order_relaxed);
-                if (!mine) mine = std::current_exception();
-            }
-        };
-        team::team_phases(schedule, i, t, phases, chunk_first, shares.get(), t, [&] { barrier.wait(t); }, guarded);
-        if (mine) std::rethrow_exception(mine);
+        guarded_part(failed, body, [&](const auto& guarded) {
+            team::team_phases(schedule, i, t, phases, chunk_first, shares.get(), t, [&] { barrier.wait(t); }, guarded);
+        });
     });
 }
 
 void PoolExecutor::for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
                                      const std::function<void(int, index_t)>& body) const {
     if (phases <= 0 || chunks <= 0) return;
-    if (threads_ == 1 || chunks == 1 || impl_->inside()) {
-        for (int p = 0; p < phases; ++p)
-            for (index_t c = 0; c < chunks; ++c) body(p, c);
-        return;
-    }
+    if (threads_ == 1 || chunks == 1 || impl_->inside()) return team::run_linked_here(phases, chunks, body);
     const int t = threads_;
     std::atomic<bool> failed{false};
     impl_->run_linked(chunks, phases, [&](int i, team::ChunkProgress* progress, std::int64_t base) {
-        std::exception_ptr mine;
-        const auto guarded = [&](int p, index_t c) {
-            if (failed.load(std::memory_order_relaxed)) return;
-            try {
-                body(p, c);
-            } catch (...) {
-                failed.store(true, std::memory_order_relaxed);
-                if (!mine) mine = std::current_exception();
-            }
-        };
-        team::team_linked_phases(i, t, phases, chunks, need_first, need_last, progress, base, guarded);
-        if (mine) std::rethrow_exception(mine);
+        guarded_part(failed, body, [&](const auto& guarded) {
+            team::team_linked_phases(i, t, phases, chunks, need_first, need_last, progress, base, guarded);
+        });
     });
 }
 
