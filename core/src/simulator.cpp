@@ -64,16 +64,12 @@ bool spd_inverse3(const double (&B)[3][3], double* inv) {
 }
 
 // Three sums over [0, n) in one pass: term(i, acc) adds to acc[0..2].
-// Per-block partials added in block order, as blocked_sum: the same for any
-// thread count.
-template <class Term>
-std::array<double, 3> blocked_sum3(const Executor& ex, std::size_t n, Term&& term) {
+// Three sums at once: block(lo, hi) gives a block's three partials, which
+// are added in block order, as blocked_sum: the same for any thread count.
+template <class Block>
+std::array<double, 3> blocked_sum3(const Executor& ex, std::size_t n, Block&& block) {
     std::vector<std::array<double, 3>> partial(vector_blocks(n), {0.0, 0.0, 0.0});
-    for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) {
-        double acc[3] = {0, 0, 0};
-        for (std::size_t i = lo; i < hi; ++i) term(i, acc);
-        partial[lo / kVectorBlock] = {acc[0], acc[1], acc[2]};
-    });
+    for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) { partial[lo / kVectorBlock] = block(lo, hi); });
     std::array<double, 3> s{0.0, 0.0, 0.0};
     for (const auto& p : partial)
         for (int k = 0; k < 3; ++k) s[k] += p[k];
@@ -447,12 +443,24 @@ struct Simulator<S>::Impl {
         forces_current = false;
     }
 
+    // Kinetic energy, gravity's potential and f_ext.u, per block as
+    // block_sum's interleaved sums over its vertices (a block holds whole
+    // vertices: kVectorBlock is a multiple of 3). One running sum per term,
+    // through the dofs, took 6.5 us per call on bunny-4k (3423 dofs).
     EnergySample sample(double W) const {
-        const std::array<double, 3> s = blocked_sum3(*exec, n(), [&](std::size_t i, double* acc) {
-            const double m = mass[i / 3], vi = double(v[i]), ui = double(u[i]);
-            acc[0] += 0.5 * m * vi * vi;
-            acc[1] -= m * scene.gravity[i % 3] * ui;
-            acc[2] += double(fext[i]) * ui;
+        const double g0 = scene.gravity[0], g1 = scene.gravity[1], g2 = scene.gravity[2];
+        const std::array<double, 3> s = blocked_sum3(*exec, n(), [&](std::size_t lo, std::size_t hi) {
+            const std::size_t a0 = lo / 3, a1 = hi / 3;
+            const auto d = [](S x) { return double(x); };
+            const double kinetic = block_sum(a0, a1, [&](std::size_t a) {
+                const double vx = d(v[3 * a]), vy = d(v[3 * a + 1]), vz = d(v[3 * a + 2]);
+                return mass[a] * (vx * vx + vy * vy + vz * vz);
+            });
+            const double gravity = block_sum(a0, a1, [&](std::size_t a) {
+                return mass[a] * (g0 * d(u[3 * a]) + g1 * d(u[3 * a + 1]) + g2 * d(u[3 * a + 2]));
+            });
+            const double load = block_sum(lo, hi, [&](std::size_t i) { return d(fext[i]) * d(u[i]); });
+            return std::array<double, 3>{0.5 * kinetic, -gravity, load};
         });
         return {s[0], W, s[1], s[2]};
     }
