@@ -74,11 +74,7 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
     double* const rr_part = pap_part + nb;
     double* const rz_part = rr_part + nb;
     double* const bb_part = rz_part + nb;
-    const auto total = [nb](const double* part) {
-        double s = 0;
-        for (std::size_t k = 0; k < nb; ++k) s += part[k];
-        return s;
-    };
+    const auto total = [nb](const double* part) { return partials_total(part, nb); };
     const index_t groups = block_groups(ex, nb);
     const index_t phase_first[4] = {0, groups, 2 * groups, 3 * groups};
     // blocks(g, body): body(lo, hi, k) over the blocks k of group g.
@@ -137,7 +133,7 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
     for (int it = 0; it < limit; ++it) {
         if (res.residual == 0) break;
         apply_A(p, Ap);
-        // Each group sums the partials it needs once, in block order.
+        // Each group sums the partials it needs once, in a fixed order (partials_total).
         ex.for_uniform_phases(3, phase_first, [&, rz](int phase, index_t g) {
             if (phase == 0) {
                 blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
