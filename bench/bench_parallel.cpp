@@ -7,6 +7,9 @@
 // core's serial loops (the reference). The step (kernel "step") is
 // bench_step's scene: h = 1 ms, gravity, the lowest 1% fixed, 20
 // warm-started CG iterations; "step/serial/core" is the serial Simulator.
+// "cg/<backend>/core/<threads>/<mesh>": CG's vector work alone (20
+// iterations on a diagonal system of the mesh's 3 #V dofs; counter
+// per_iteration). Back-ends: OpenMP, oneTBB and the pool.
 // Counters: per_tet (s per tet, shown as ns), bytes (compulsory bytes moved per call, force kernel only) and
 // bytes_per_second; times are wall-clock (UseRealTime). Every mesh is
 // renumbered by reverse Cuthill-McKee first (partition/), the locality
@@ -30,6 +33,7 @@
 
 #include "bench_meshes.hpp"
 #include "edgefem/core/benchmark_scene.hpp"
+#include "edgefem/core/cg.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/edge_kernels.hpp"
@@ -234,6 +238,38 @@ void BM_Step(benchmark::State& state, std::string mesh, Backend b, Variant v, in
                                                    benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+// CG's vector work alone: 20 iterations on a diagonal system with as many
+// dofs as the mesh's step (3 #V), so that the step rows' CG part can be
+// told from the kernels' (Jacobi preconditioner, no product). Serial when
+// `threads` is 0. On a small mesh this is mostly the cost of an
+// iteration's two barriers and its call.
+void BM_Cg(benchmark::State& state, std::string mesh, Backend b, int threads) {
+    const std::size_t n = 3 * std::size_t(prepared(mesh).mesh.num_vertices());
+    std::vector<double> d(n), rhs(n), x(n);
+    std::vector<std::uint8_t> free_dof(n, 1);
+    for (std::size_t i = 0; i < n; ++i) {
+        d[i] = 1.0 + double(i % 7);
+        rhs[i] = std::sin(0.3 * double(i));
+    }
+    const auto ex = threads > 0 ? make_executor(b, threads) : std::make_shared<SerialExecutor>();
+    CgWork w;
+    for (auto _ : state) {
+        std::fill(x.begin(), x.end(), 0.0);
+        const CgResult r = conjugate_gradient(
+            *ex, n, free_dof.data(), [](const double*, double*) {},
+            [&](std::size_t lo, std::size_t hi, const double* in, double* out) {
+                for (std::size_t i = lo; i < hi; ++i) out[i] = d[i] * in[i];
+            },
+            [&](std::size_t lo, std::size_t hi, const double* r_in, double* z) {
+                for (std::size_t i = lo; i < hi; ++i) z[i] = r_in[i] / d[i];
+            },
+            rhs.data(), x.data(), 0.0, 20, 20, w);
+        benchmark::DoNotOptimize(r.residual);
+    }
+    state.counters["per_iteration"] =
+        benchmark::Counter(20.0, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 // 1, 2, 4, ... below the cores present, then that count; or the list in
 // $EDGEFEM_BENCH_THREADS.
 std::vector<int> thread_counts() {
@@ -296,7 +332,18 @@ int main(int argc, char** argv) {
                                      Backend::Serial, Variant::Auto, 0)
             ->Unit(benchmark::kMicrosecond)
             ->UseRealTime();
-        for (Backend b : {Backend::OpenMP, Backend::TBB})
+        benchmark::RegisterBenchmark((std::string("cg/serial/core/1/") + mesh).c_str(), BM_Cg, std::string(mesh),
+                                     Backend::Serial, 0)
+            ->Unit(benchmark::kMicrosecond)
+            ->UseRealTime();
+        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+            for (int t : threads)
+                benchmark::RegisterBenchmark(
+                    (std::string("cg/") + to_string(b) + "/core/" + std::to_string(t) + "/" + mesh).c_str(), BM_Cg,
+                    std::string(mesh), b, t)
+                    ->Unit(benchmark::kMicrosecond)
+                    ->UseRealTime();
+        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
             for (Variant v : kAllVariants)
                 for (int t : threads) {
                     for (Kernel k : {Kernel::Force, Kernel::Stiffness, Kernel::Kx}) {

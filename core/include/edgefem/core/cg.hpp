@@ -2,7 +2,7 @@
 // degrees of freedom keep the value they have in x on entry, the others solve
 // P A P x = P b. Matrix-free: A and the preconditioner are callables. The
 // vector updates run as fixed blocks on the executor and dot products sum
-// per-block partials in block order: bitwise the same for any thread count.
+// per-block partials in a fixed order: bitwise the same for any thread count.
 #pragma once
 
 #include <cmath>
@@ -40,8 +40,8 @@ struct CgWork {
 // blocks, one parallel region with two barriers: (0) finish A p, partials
 // of p.Ap; (1) alpha, x and r updated, partials of r.r, z = M^-1 r,
 // partials of r.z; (2) beta, p updated. Every group sums the partials in
-// block order itself, so no serial section sits between the phases and the
-// sums are the same for any thread count. (On armadillo-7k a step's CG
+// one fixed order itself (partials_total), so no serial section sits
+// between the phases and the sums are the same for any thread count. (On armadillo-7k a step's CG
 // vector work ran as ~7 whole-vector passes on one thread: its 6558 dofs
 // were one block.)
 template <class ApplyA, class FinishA, class ApplyM>
