@@ -7,10 +7,13 @@
 // (Executor::for_linked_phases, the default) and with a barrier between
 // phases (the Executor base class's for_linked_phases), and prints each
 // round's medians and their ratio: the two run in one process, paired
-// round by round (docs/parallel.md, Update 7). A diagnostic, not a
-// benchmark: the tracer's stamps cost ~20 ns per part.
+// round by round (docs/parallel.md, Update 7). `step` instead runs
+// semi-implicit steps (bench_step's scene, 20 CG iterations) and prints the
+// wall time per step of every executor call site (the loop body's type):
+// where a step's time goes on N threads. A diagnostic, not a benchmark: the
+// tracer's stamps cost ~20 ns per part.
 //
-//   edgefem_phase_timeline MESH [force|stiffness|kx] [--backend pool|omp|tbb|serial]
+//   edgefem_phase_timeline MESH [force|stiffness|kx|step] [--backend pool|omp|tbb|serial]
 //                          [--threads N] [--barriers] [--calls N] [--compare ROUNDS]
 //
 // MESH: a name of bench_meshes.hpp (box-1200, bunny-4k, ...: ../shared/meshes
@@ -24,8 +27,16 @@
 #include <string>
 #include <vector>
 
+#include <cxxabi.h>
+
+#include <map>
+#include <typeindex>
+
 #include "bench_meshes.hpp"
+#include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/parallel_operator.hpp"
 #include "edgefem/core/deformations.hpp"
 #include "edgefem/core/tet_edge_form.hpp"
 #include "edgefem/parallel/executors.hpp"
@@ -58,32 +69,49 @@ public:
     int threads() const override { return inner_->threads(); }
     const char* name() const override { return inner_->name(); }
     void for_chunks(index_t n, const std::function<void(index_t)>& body) const override {
-        inner_->for_chunks(n, body);
+        timed(body.target_type(), "chunks", [&] { inner_->for_chunks(n, body); });
     }
     void for_uniform_chunks(index_t n, const std::function<void(index_t)>& body) const override {
-        inner_->for_uniform_chunks(n, body);
+        timed(body.target_type(), "uniform chunks", [&] { inner_->for_uniform_chunks(n, body); });
     }
     void for_phases(int phases, const index_t* first, const std::function<void(int, index_t)>& body) const override {
-        inner_->for_phases(phases, first, traced(body));
+        timed(body.target_type(), "phases", [&] { inner_->for_phases(phases, first, traced(body)); });
     }
     void for_uniform_phases(int phases, const index_t* first,
                             const std::function<void(int, index_t)>& body) const override {
-        inner_->for_uniform_phases(phases, first, traced(body));
+        timed(body.target_type(), "uniform phases", [&] { inner_->for_uniform_phases(phases, first, traced(body)); });
     }
     void for_linked_phases(int phases, index_t chunks, const index_t* need_first, const index_t* need_last,
                            const std::function<void(int, index_t)>& body) const override {
         if (barriers)  // the base class: for_uniform_phases, a barrier between phases
             Executor::for_linked_phases(phases, chunks, need_first, need_last, body);
         else
-            inner_->for_linked_phases(phases, chunks, need_first, need_last, traced(body));
+            timed(body.target_type(), "linked phases", [&] {
+                inner_->for_linked_phases(phases, chunks, need_first, need_last, traced(body));
+            });
     }
 
     bool barriers = false;
-    bool recording = false;
+    bool recording = false;  // stamps of phased calls
+    bool sites = false;      // wall time per call site
     // Per thread, its stamps in time order.
     mutable std::vector<std::vector<Stamp>> stamps_;
+    struct Site {
+        double ns = 0;
+        long calls = 0;
+    };
+    mutable std::map<std::pair<std::type_index, std::string>, Site> site_;
 
 private:
+    template <class Run>
+    void timed(const std::type_info& type, const char* kind, Run&& run) const {
+        const double t0 = sites ? now_ns() : 0;
+        run();
+        if (!sites) return;
+        Site& s = site_[{std::type_index(type), kind}];
+        s.ns += now_ns() - t0;
+        ++s.calls;
+    }
     std::function<void(int, index_t)> traced(const std::function<void(int, index_t)>& body) const {
         return [this, &body](int p, index_t c) {
             const double t0 = now_ns();
@@ -117,13 +145,51 @@ int positive(const char* s, const char* what) {
     return int(v);
 }
 
+std::string demangled(const std::type_index& t) {
+    int status = 0;
+    char* s = abi::__cxa_demangle(t.name(), nullptr, nullptr, &status);
+    std::string out = status == 0 && s ? s : t.name();
+    std::free(s);
+    return out;
+}
+
+// `calls` steps (after 20 to warm up), then the wall time per step of every
+// call site, largest first.
+int step_sites(const Mesh& mesh, const std::string& name, Backend b, int threads, int calls) {
+    auto tracer = std::make_shared<TracingExecutor>(make_executor(b, threads));
+    Scene scene = step_benchmark_scene(mesh, Materials(Material{1e5, 0.3, 1000}));
+    scene.solver.cg_fixed_iterations = 20;
+    Simulator<double> sim(std::move(scene), tracer, parallel_operator_factory<double>(tracer, Variant::Auto));
+    for (int i = 0; i < 20; ++i) sim.step();
+    tracer->sites = true;
+    const double t0 = now_ns();
+    for (int i = 0; i < calls; ++i) sim.step();
+    const double step = (now_ns() - t0) / calls;
+    tracer->sites = false;
+    std::vector<std::pair<double, std::string>> rows;
+    double in_calls = 0;
+    for (const auto& [key, site] : tracer->site_) {
+        in_calls += site.ns / calls;
+        char head[64];
+        std::snprintf(head, sizeof head, "%5.1f calls, %s: ", double(site.calls) / calls, key.second.c_str());
+        rows.emplace_back(site.ns / calls, head + demangled(key.first).substr(0, 160));
+    }
+    std::sort(rows.rbegin(), rows.rend());
+    std::printf("mesh %s (%d tets), step (20 CG iterations), backend %s x%d: %.1f us per step, %.1f in executor "
+                "calls\n",
+                name.c_str(), mesh.num_tets(), tracer->name(), tracer->threads(), step / 1e3, in_calls / 1e3);
+    for (const auto& [ns, what] : rows)
+        if (ns >= 100) std::printf("%8.1f us  %s\n", ns / 1e3, what.c_str());
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     if (argc < 2) usage("no mesh given");
     const std::string mesh_name = argv[1];
     std::string kernel = "force", backend = "pool";
-    int threads = 2, calls = 3000, compare = 0;
+    int threads = 2, calls = 0, compare = 0;  // calls 0: 3000 kernel calls or 200 steps
     bool barriers = false;
     for (int i = 2; i < argc; ++i) {
         const std::string a = argv[i];
@@ -131,7 +197,7 @@ int main(int argc, char** argv) {
             if (i + 1 >= argc) usage(a + " needs a value");
             return argv[++i];
         };
-        if (a == "force" || a == "stiffness" || a == "kx") kernel = a;
+        if (a == "force" || a == "stiffness" || a == "kx" || a == "step") kernel = a;
         else if (a == "--backend") backend = value();
         else if (a == "--threads") threads = positive(value(), "--threads");
         else if (a == "--calls") calls = positive(value(), "--calls");
@@ -147,6 +213,8 @@ int main(int argc, char** argv) {
     }
 
     const Mesh& mesh = bench::bench_mesh(mesh_name + "@rcm");
+    if (kernel == "step") return step_sites(mesh, mesh_name, b, threads, calls > 0 ? calls : 200);
+    if (calls == 0) calls = 3000;
     const Topology topo = build_topology(mesh);
     const Materials mat(Material{1e5, 0.3, 1000});
     const EdgeModel<double> model = make_edge_model<double>(topo, compute_coefficients(mesh, topo, mat));
