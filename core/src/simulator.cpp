@@ -64,15 +64,15 @@ bool spd_inverse3(const double (&B)[3][3], double* inv) {
 }
 
 // Three sums over [0, n) in one pass: term(i, acc) adds to acc[0..2].
-// Three sums at once: block(lo, hi) gives a block's three partials, which
-// are added in block order, as blocked_sum: the same for any thread count.
-template <class Block>
-std::array<double, 3> blocked_sum3(const Executor& ex, std::size_t n, Block&& block) {
-    std::vector<std::array<double, 3>> partial(vector_blocks(n), {0.0, 0.0, 0.0});
+// K sums at once: block(lo, hi) gives a block's K partials, which are added
+// in block order, as blocked_sum: the same for any thread count.
+template <std::size_t K, class Block>
+std::array<double, K> blocked_sums(const Executor& ex, std::size_t n, Block&& block) {
+    std::vector<std::array<double, K>> partial(vector_blocks(n));
     for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) { partial[lo / kVectorBlock] = block(lo, hi); });
-    std::array<double, 3> s{0.0, 0.0, 0.0};
+    std::array<double, K> s{};
     for (const auto& p : partial)
-        for (int k = 0; k < 3; ++k) s[k] += p[k];
+        for (std::size_t k = 0; k < K; ++k) s[k] += p[k];
     return s;
 }
 
@@ -87,30 +87,40 @@ struct Scaled {
     double value() const { return std::ldexp(mant, exp); }
 };
 
+// The exponent of the largest |term(i)|; `bad` gets the last non-finite
+// one in index order. Per block on the executor (a maximum is exact in any
+// order), so that Newton has no serial pass over the dofs.
 template <class Term>
-int max_exponent(std::size_t n, Term&& term, double& bad) {
+int max_exponent(const Executor& ex, std::size_t n, Term&& term, double& bad) {
+    std::vector<std::array<double, 2>> part(vector_blocks(n), {0.0, 0.0});  // {max, last non-finite}
+    for_blocks(ex, n, [&](std::size_t lo, std::size_t hi) {
+        double mx = 0, b = 0;
+        for (std::size_t i = lo; i < hi; ++i) {
+            const double t = std::abs(term(i));
+            if (!std::isfinite(t)) b = t;
+            mx = std::max(mx, t);
+        }
+        part[lo / kVectorBlock] = {mx, b};
+    });
     double mx = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const double t = std::abs(term(i));
-        if (!std::isfinite(t)) bad = t;
-        mx = std::max(mx, t);
+    for (const auto& p : part) {
+        if (p[1] != 0) bad = p[1];
+        mx = std::max(mx, p[0]);
     }
     return mx > 0 ? std::ilogb(mx) : 0;
 }
 
 template <class A, class B>
-Scaled scaled_dot(std::size_t n, A&& a, B&& b) {
+Scaled scaled_dot(const Executor& ex, std::size_t n, A&& a, B&& b) {
     double bad = 0;
-    const int ea = max_exponent(n, a, bad), eb = max_exponent(n, b, bad);
+    const int ea = max_exponent(ex, n, a, bad), eb = max_exponent(ex, n, b, bad);
     if (bad != 0) return {bad, 0};
-    double s = 0;
-    for (std::size_t i = 0; i < n; ++i) s += std::ldexp(a(i), -ea) * std::ldexp(b(i), -eb);
-    return {s, ea + eb};
+    return {blocked_sum(ex, n, [&](std::size_t i) { return std::ldexp(a(i), -ea) * std::ldexp(b(i), -eb); }), ea + eb};
 }
 
 template <class Term>
-double scaled_norm(std::size_t n, Term&& term) {
-    const Scaled s = scaled_dot(n, term, term);
+double scaled_norm(const Executor& ex, std::size_t n, Term&& term) {
+    const Scaled s = scaled_dot(ex, n, term, term);
     return std::isfinite(s.mant) ? std::ldexp(std::sqrt(s.mant), s.exp / 2) : s.mant;
 }
 
@@ -342,12 +352,23 @@ struct Simulator<S>::Impl {
     // direction of noise). Scaling by a power of two is exact, so a solve
     // that needs no scaling is unchanged.
     double solve_scale(double c_m) const {
+        // Maxima per block on the executor (exact in any order).
+        std::vector<std::array<double, 3>> part(vector_blocks(n()), {0.0, 0.0, 0.0});
+        for_blocks(*exec, n(), [&](std::size_t lo, std::size_t hi) {
+            double bm = 0, xm = 0, mm = 0;
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (free_dof[i]) bm = std::max(bm, std::abs(b[i]));
+                xm = std::max(xm, std::abs(x[i]));
+                mm = std::max(mm, mass_dof[i]);
+            }
+            part[lo / kVectorBlock] = {bm, xm, mm};
+        });
         double bmax = 0, xmax = 0, mmax = 0;
-        for (std::size_t i = 0; i < n(); ++i) {
-            if (free_dof[i]) bmax = std::max(bmax, std::abs(b[i]));
-            xmax = std::max(xmax, std::abs(x[i]));
+        for (const auto& p : part) {
+            bmax = std::max(bmax, p[0]);
+            xmax = std::max(xmax, p[1]);
+            mmax = std::max(mmax, p[2]);
         }
-        for (double m : mass) mmax = std::max(mmax, m);
         const double mag = std::max(bmax, c_m * mmax * xmax);
         if (!(mag > 0) || !std::isfinite(mag) || (mag > 0x1p-100 && mag < 0x1p100)) return 1;
         return std::ldexp(1.0, std::ilogb(mag));
@@ -462,7 +483,7 @@ struct Simulator<S>::Impl {
     // through the dofs, took 6.5 us per call on bunny-4k (3423 dofs).
     EnergySample sample(double W) const {
         const double g0 = scene.gravity[0], g1 = scene.gravity[1], g2 = scene.gravity[2];
-        const std::array<double, 3> s = blocked_sum3(*exec, n(), [&](std::size_t lo, std::size_t hi) {
+        const std::array<double, 3> s = blocked_sums<3>(*exec, n(), [&](std::size_t lo, std::size_t hi) {
             const std::size_t a0 = lo / 3, a1 = hi / 3;
             const auto d = [](S x) { return double(x); };
             const double kinetic = block_sum(a0, a1, [&](std::size_t a) {
@@ -689,34 +710,43 @@ struct Simulator<S>::Impl {
             mag = std::abs(W);
             std::vector<double>& d = newton_d;
             d.resize(n());
-            for (std::size_t i = 0; i < n(); ++i) d[i] = double(u[i]) - (dynamic ? u0[i] : 0.0);
+            each([&](std::size_t i) { d[i] = double(u[i]) - (dynamic ? u0[i] : 0.0); });
             if (c_b != 0) multiply(*op_damp, d.data(), K0d.data());
-            for (std::size_t i = 0; i < n(); ++i) {
-                double r = double(f[i]) - h[i];
-                phi -= h[i] * double(u[i]);
-                mag += std::abs(h[i] * double(u[i]));
-                inertia[i] = 0;
-                if (dynamic) {
-                    const double m = mass[i / 3], e = double(u[i]) - upred[i];
-                    inertia[i] = m * e / (T * T) + scene.rayleigh_alpha * m * d[i] / T + c_b * K0d[i];
-                    r += inertia[i];
-                    const double kin = 0.5 * m * e * e / (T * T) + 0.5 * scene.rayleigh_alpha * m * d[i] * d[i] / T +
-                                       0.5 * c_b * d[i] * K0d[i];
-                    phi += kin;
-                    mag += std::abs(kin);
+            // Per block: R and the inertia terms, and the sums of h.u, |h u|,
+            // the kinetic terms and their sizes.
+            const std::array<double, 4> sums = blocked_sums<4>(*exec, n(), [&](std::size_t lo, std::size_t hi) {
+                std::array<double, 4> acc{};
+                for (std::size_t i = lo; i < hi; ++i) {
+                    double r = double(f[i]) - h[i];
+                    acc[0] += h[i] * double(u[i]);
+                    acc[1] += std::abs(h[i] * double(u[i]));
+                    inertia[i] = 0;
+                    if (dynamic) {
+                        const double m = mass[i / 3], e = double(u[i]) - upred[i];
+                        inertia[i] = m * e / (T * T) + scene.rayleigh_alpha * m * d[i] / T + c_b * K0d[i];
+                        r += inertia[i];
+                        const double kin = 0.5 * m * e * e / (T * T) +
+                                           0.5 * scene.rayleigh_alpha * m * d[i] * d[i] / T + 0.5 * c_b * d[i] * K0d[i];
+                        acc[2] += kin;
+                        acc[3] += std::abs(kin);
+                    }
+                    R[i] = free_dof[i] ? r : 0.0;
                 }
-                R[i] = free_dof[i] ? r : 0.0;
-            }
-            scale = scaled_norm(n(), [&](std::size_t i) { return double(f[i]); }) +
-                    scaled_norm(n(), [&](std::size_t i) { return h[i]; }) +
-                    scaled_norm(n(), [&](std::size_t i) { return inertia[i]; });
+                return acc;
+            });
+            phi += sums[2] - sums[0];
+            mag += sums[1] + sums[3];
+            scale = scaled_norm(*exec, n(), [&](std::size_t i) { return double(f[i]); }) +
+                    scaled_norm(*exec, n(), [&](std::size_t i) { return h[i]; }) +
+                    scaled_norm(*exec, n(), [&](std::size_t i) { return inertia[i]; });
         };
         auto norm = [&](const std::vector<double>& a) {
-            return scaled_norm(n(), [&](std::size_t i) { return a[i]; });
+            return scaled_norm(*exec, n(), [&](std::size_t i) { return a[i]; });
         };
         // du.R: its sign from the scaled sum (the value may underflow).
         auto slope_of = [&](bool& descent) {
-            const Scaled sl = scaled_dot(n(), [&](std::size_t i) { return x[i]; }, [&](std::size_t i) { return R[i]; });
+            const Scaled sl =
+                scaled_dot(*exec, n(), [&](std::size_t i) { return x[i]; }, [&](std::size_t i) { return R[i]; });
             descent = sl.mant < 0;
             return sl.value();
         };
@@ -770,28 +800,28 @@ struct Simulator<S>::Impl {
                                   -1};
             ++stats.newton_iterations;
             // Solve (c_m M + K + c_b K0) du = -R, du = 0 on constrained dofs.
-            for (std::size_t i = 0; i < n(); ++i) {
+            each([&](std::size_t i) {
                 b[i] = -R[i];
                 x[i] = 0;
-            }
+            });
             const double eta = std::min(1e-2, std::max(1e-12, rn / std::max(scale, 1e-300)));
             solve(c_m, 1.0, c_b, eta, sv.definite_stiffness);
             bool descent = false, newton_direction = true;
             double slope = slope_of(descent);
             if (!descent || !std::isfinite(slope)) {  // not a descent direction: use the definite K
                 if (scene.method == Method::Edge) {
-                    for (std::size_t i = 0; i < n(); ++i) x[i] = 0;
+                    each([&](std::size_t i) { x[i] = 0; });
                     solve_once(c_m, 1.0, c_b, eta, true);
                     slope = slope_of(descent);
                 }
                 if (!descent) {  // last resort: scaled gradient
                     newton_direction = false;
-                    for (std::size_t i = 0; i < n(); ++i) x[i] = -R[i] / (mass[i / 3] * std::max(c_m, 1.0));
+                    each([&](std::size_t i) { x[i] = -R[i] / (mass[i / 3] * std::max(c_m, 1.0)); });
                     slope = slope_of(descent);
                 }
             }
-            du.assign(x.begin(), x.end());
-            for (std::size_t i = 0; i < n(); ++i) trial[i] = double(u[i]);
+            copy_state(du, x);
+            each([&](std::size_t i) { trial[i] = double(u[i]); });
             const bool below_resolution = newton_direction && norm(du) <= 8 * eps * norm(trial);
             if (below_resolution && stalled >= 1) {  // (c)
                 stats.newton_round_off = true;
@@ -804,7 +834,7 @@ struct Simulator<S>::Impl {
             // descent direction for it too).
             double step_len = 1, phi_new = 0, scale_new = 0, mag_new = 0;
             for (int ls = 0;; ++ls) {
-                for (std::size_t i = 0; i < n(); ++i) u[i] = S(trial[i] + step_len * du[i]);
+                each([&](std::size_t i) { u[i] = S(trial[i] + step_len * du[i]); });
                 evaluate(phi_new, scale_new, mag_new);
                 if (std::isfinite(phi_new)) {
                     const double decrease = -1e-4 * step_len * slope;
@@ -815,7 +845,7 @@ struct Simulator<S>::Impl {
                     }
                 }
                 if (ls == 40) {
-                    for (std::size_t i = 0; i < n(); ++i) u[i] = S(trial[i]);
+                    each([&](std::size_t i) { u[i] = S(trial[i]); });
                     evaluate(phi, scale, mag);  // back to the iterate (and its f, W)
                     if (at_floor()) return;     // (b)
                     if (below_resolution) {     // (c)
@@ -840,10 +870,10 @@ struct Simulator<S>::Impl {
     void implicit_step(double T) {
         external(1.0);
         std::vector<double> u0(n()), upred(n());
-        for (std::size_t i = 0; i < n(); ++i) {
+        each([&](std::size_t i) {
             u0[i] = double(u[i]);
             upred[i] = u0[i] + T * double(v[i]);
-        }
+        });
         if (scene.rayleigh_beta > 0) {
             if (!op_damp) op_damp = factory(scene.mesh, scene.materials, scene.model, scene.method);
             std::vector<S> scratch(n());
@@ -852,19 +882,20 @@ struct Simulator<S>::Impl {
         }
         // Start from the prediction with the constrained dofs at their targets.
         const double s = ramp(time + T);
-        for (std::size_t i = 0; i < n(); ++i) u[i] = S(upred[i]);
+        each([&](std::size_t i) { u[i] = S(upred[i]); });
         for (std::size_t k = 0; k < con_vertex.size(); ++k)
             for (int r = 0; r < 3; ++r) u[3 * std::size_t(con_vertex[k]) + r] = S(s * con_disp[k][r]);
         newton(T, u0, upred);
-        for (std::size_t i = 0; i < n(); ++i) v[i] = S((double(u[i]) - u0[i]) / T);
+        each([&](std::size_t i) { v[i] = S((double(u[i]) - u0[i]) / T); });
     }
 
     void advance(double T, int depth) {
         // The state is saved only when a failed step may be retried (the
         // whole step's start is kept by do_step).
         const bool may_retry = depth < scene.solver.max_step_halvings;
+        // Depth 0 restores the step's start, which do_step has just saved.
         std::vector<S> u_save, v_save;
-        if (may_retry) {
+        if (may_retry && depth > 0) {
             u_save = u;
             v_save = v;
         }
@@ -890,8 +921,13 @@ struct Simulator<S>::Impl {
         } catch (const StepFailure& failure) {
             forces_current = false;
             if (!may_retry) throw;
-            u = u_save;
-            v = v_save;
+            if (depth == 0) {
+                copy_state(u, step_start_u);
+                copy_state(v, step_start_v);
+            } else {
+                u = u_save;
+                v = v_save;
+            }
             ++stats.halvings;
             advance(T / 2, depth + 1);
             advance(T / 2, depth + 1);

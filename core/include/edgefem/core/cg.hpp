@@ -89,12 +89,16 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
     // dividing by 1 instead made the tolerance absolute: on a soft body
     // CG stopped after 0 iterations with the free vertices unmoved. The
     // extra product runs only when a constrained value is non-zero.
-    int any_moving = 0;  // branch-free, so the scan vectorises (it runs once per solve)
-    for (std::size_t i = 0; i < n; ++i) any_moving |= int(free_dof[i] == 0) & int(x[i] != 0);
-    const bool moving_constraints = any_moving != 0;
+    // The scan runs on the executor's blocks, as every pass over the dofs
+    // (a count: the same for any thread count).
+    const bool moving_constraints = blocked_sum(ex, n, [=](std::size_t i) {
+                                        return double(int(free_dof[i] == 0) & int(x[i] != 0));
+                                    }) > 0;
     double bnorm = 0;
     if (moving_constraints) {
-        for (std::size_t i = 0; i < n; ++i) z[i] = free_dof[i] ? 0.0 : x[i];
+        for_blocks(ex, n, [=](std::size_t lo, std::size_t hi) {
+            for (std::size_t i = lo; i < hi; ++i) z[i] = free_dof[i] ? 0.0 : x[i];
+        });
         apply_A(z, Ap);
         ex.for_uniform_phases(1, phase_first, [&](int, index_t g) {
             blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
