@@ -959,7 +959,7 @@ struct Simulator<S>::Impl {
     }
 
     StaticResult do_static() {
-        for (auto& x_ : v) x_ = S(0);
+        each([&](std::size_t i) { v[i] = S(0); });
         if (con_vertex.empty())
             throw InvalidArgument("static equilibrium needs fixed or prescribed vertices (else it is singular)");
         stats = StepStats{};
@@ -971,16 +971,17 @@ struct Simulator<S>::Impl {
         // a 96-tet bar, thousands of tiny increments each failing anew.)
         double done = 0, inc = 1.0 / scene.solver.load_steps;
         int halvings = 0;
+        std::vector<S> u_save;
         while (done < 1 - 1e-15) {
             const double load = std::min(1.0, done + inc);
-            const std::vector<S> u_save = u;
+            copy_state(u_save, u);
             external(load);
             for (std::size_t k = 0; k < con_vertex.size(); ++k)
                 for (int r = 0; r < 3; ++r) u[3 * std::size_t(con_vertex[k]) + r] = S(load * con_disp[k][r]);
             try {
                 newton(0.0, none, none);
             } catch (const StepFailure& failure) {
-                u = u_save;
+                copy_state(u, u_save);
                 if (++halvings > 12)
                     throw SimulationError("static solve: load fraction " + fmt_load(done) + " -> " + fmt_load(load) + ": " +
                                               failure.message + " even with load increment " + sci(inc) +
