@@ -166,6 +166,29 @@ TEST(ParallelTsan, PoolExecutor) {
     }
 }
 
+// Newton on the pool (an implicit step with damping, a static solve): its
+// residual, norms, line search and updates run on the executor's blocks;
+// 3 threads give the bits of 1.
+TEST(ParallelTsan, PoolNewton) {
+    std::vector<std::vector<double>> out;
+    for (int threads : {1, 3}) {
+        const auto ex = make_executor(Backend::Pool, threads);
+        Scene s = edgefem::test::clamped_box_scene(5, 2, 2);
+        s.integrator = Integrator::Implicit;
+        s.dt = 2e-3;
+        s.rayleigh_alpha = 0.5;
+        s.rayleigh_beta = 1e-3;
+        Simulator<double> sim(s, ex, parallel_operator_factory<double>(ex, Variant::Auto));
+        sim.step();
+        Simulator<double> st(edgefem::test::clamped_box_scene(5, 2, 2), ex, parallel_operator_factory<double>(ex, Variant::Auto));
+        EXPECT_TRUE(st.solve_static().converged);
+        std::vector<double> u(sim.displacement().begin(), sim.displacement().end());
+        u.insert(u.end(), st.displacement().begin(), st.displacement().end());
+        out.push_back(std::move(u));
+    }
+    EXPECT_TRUE(same(out[0], out[1]));
+}
+
 // Linked phases on the pool: each chunk writes plain (non-atomic) data that
 // the chunks linked to it read in the next phase, so a TSan build sees a
 // race if a link's happens-before (the chunk counts' release and acquire)
