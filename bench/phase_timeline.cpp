@@ -132,7 +132,7 @@ double median(std::vector<double> v) {
 
 [[noreturn]] void usage(const std::string& why) {
     std::fprintf(stderr,
-                 "edgefem_phase_timeline: %s\nusage: edgefem_phase_timeline MESH [force|stiffness|kx] "
+                 "edgefem_phase_timeline: %s\nusage: edgefem_phase_timeline MESH [force|stiffness|kx|step] "
                  "[--backend pool|omp|tbb|serial] [--threads N] [--barriers] [--calls N] [--compare ROUNDS]\n",
                  why.c_str());
     std::exit(2);
@@ -212,7 +212,14 @@ int main(int argc, char** argv) {
         usage(e.what());
     }
 
-    const Mesh& mesh = bench::bench_mesh(mesh_name + "@rcm");
+    const Mesh* loaded = nullptr;
+    try {
+        loaded = &bench::bench_mesh(mesh_name + "@rcm");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "edgefem_phase_timeline: %s\n", e.what());
+        return 2;
+    }
+    const Mesh& mesh = *loaded;
     if (kernel == "step") return step_sites(mesh, mesh_name, b, threads, calls > 0 ? calls : 200);
     if (calls == 0) calls = 3000;
     const Topology topo = build_topology(mesh);

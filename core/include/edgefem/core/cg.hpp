@@ -41,9 +41,9 @@ struct CgWork {
 // of p.Ap; (1) alpha, x and r updated, partials of r.r, z = M^-1 r,
 // partials of r.z; (2) beta, p updated. Every group sums the partials in
 // one fixed order itself (partials_total), so no serial section sits
-// between the phases and the sums are the same for any thread count. (On armadillo-7k a step's CG
-// vector work ran as ~7 whole-vector passes on one thread: its 6558 dofs
-// were one block.)
+// between the phases and the sums are the same for any thread count. (On
+// armadillo-7k a step's CG vector work ran as ~7 whole-vector passes on one
+// thread: its 6558 dofs were one block.)
 template <class ApplyA, class FinishA, class ApplyM>
 CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_t* free_dof, ApplyA&& apply_A,
                             FinishA&& finish_A, ApplyM&& apply_M, const double* b, double* x, double tolerance,
