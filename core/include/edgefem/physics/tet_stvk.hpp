@@ -57,14 +57,10 @@ EDGEFEM_FORMULA void tet_deformation(const T (&U)[4][3], const T (&Dinv)[3][3], 
     }
 }
 
-// The nodal forces f[i] (the energy gradient) of the tet: P = S + H S, then
-// P a_i.
+// The nodal vectors of a (volume-scaled) first Piola-Kirchhoff stress P:
+// f_i = P a_i for i = 1..3 and f_0 = -(f_1 + f_2 + f_3).
 template <class T>
-EDGEFEM_FORMULA void tet_forces(const TetDeformation<T>& d, const T (&Dinv)[3][3], T (&f)[4][3]) {
-    T P[3][3];
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-            P[r][c] = d.Sv[r][c] + d.H[r][0] * d.Sv[0][c] + d.H[r][1] * d.Sv[1][c] + d.H[r][2] * d.Sv[2][c];
+EDGEFEM_FORMULA void nodal_vectors(const T (&P)[3][3], const T (&Dinv)[3][3], T (&f)[4][3]) {
     for (int r = 0; r < 3; ++r) {
         T sum = {};
         for (int i = 0; i < 3; ++i) {
@@ -73,6 +69,17 @@ EDGEFEM_FORMULA void tet_forces(const TetDeformation<T>& d, const T (&Dinv)[3][3
         }
         f[0][r] = -sum;
     }
+}
+
+// The nodal forces f[i] (the energy gradient) of the tet: P = S + H S, then
+// its nodal vectors.
+template <class T>
+EDGEFEM_FORMULA void tet_forces(const TetDeformation<T>& d, const T (&Dinv)[3][3], T (&f)[4][3]) {
+    T P[3][3];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+            P[r][c] = d.Sv[r][c] + d.H[r][0] * d.Sv[0][c] + d.H[r][1] * d.Sv[1][c] + d.H[r][2] * d.Sv[2][c];
+    nodal_vectors(P, Dinv, f);
 }
 
 // The gradients a_0..a_3 of the barycentric coordinates.
@@ -136,8 +143,9 @@ EDGEFEM_FORMULA T tet_stiffness_entry(const TetStiffnessTerms<T>& k, int i, int 
     return v;
 }
 
-// y_i += dP a_i for a direction x: dF = dDx Dm^-1, dP = dF S + F dS (the
-// K x of one tet without stored blocks), into dy[4][3] (overwritten).
+// The K x of one tet without stored blocks, for a direction x given per
+// vertex (X): dF = dX Dm^-1, dP = dF S + F dS, dy = the nodal vectors of dP
+// (overwritten).
 template <class S, class T>
 EDGEFEM_FORMULA void tet_stiffness_times(const TetDeformation<T>& d, const T (&X)[4][3], const T (&Dinv)[3][3],
                                          T vol_lambda, T vol_mu, T (&dy)[4][3]) {
@@ -167,14 +175,7 @@ EDGEFEM_FORMULA void tet_stiffness_times(const TetDeformation<T>& d, const T (&X
             for (int k = 0; k < 3; ++k) s += dF[i][k] * d.Sv[k][j] + F[i][k] * dS[k][j];
             dP[i][j] = s;
         }
-    for (int r = 0; r < 3; ++r) {
-        T sum = {};
-        for (int i = 0; i < 3; ++i) {
-            dy[i + 1][r] = dP[r][0] * Dinv[i][0] + dP[r][1] * Dinv[i][1] + dP[r][2] * Dinv[i][2];
-            sum += dy[i + 1][r];
-        }
-        dy[0][r] = -sum;
-    }
+    nodal_vectors(dP, Dinv, dy);
 }
 
 }  // namespace edgefem::physics
