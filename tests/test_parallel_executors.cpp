@@ -13,7 +13,7 @@
 #include "edgefem/core/error.hpp"
 #include "edgefem/parallel/barrier_latency.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/variant.hpp"
+#include "cpu/variant.hpp"
 #include "test_threads.hpp"
 
 using namespace edgefem;

@@ -17,11 +17,11 @@
 #include "edgefem/core/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/deformations.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "cpu/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "cpu/cpu_operator.hpp"
 #include "edgefem/parallel/barrier_latency.hpp"
 #include "edgefem/parallel/stream_bandwidth.hpp"
 

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "edgefem/core/cg.hpp"
+#include "edgefem/core/reference_operator.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/sparse_assembly.hpp"
 
@@ -217,7 +218,7 @@ struct Simulator<S>::Impl {
         scene.validate();
         if (!exec) exec = std::make_shared<SerialExecutor>();
         if (!factory) factory = [](const Mesh& m, const Materials& mat, ModelKind k, Method me) {
-            return make_elastic_operator<S>(m, mat, k, me);
+            return make_reference_operator<S>(m, mat, k, me);
         };
         const Mesh& mesh = scene.mesh;
         op = factory(mesh, scene.materials, scene.model, scene.method);

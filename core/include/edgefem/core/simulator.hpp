@@ -60,9 +60,10 @@ struct StaticResult {
     bool converged = false;
 };
 
-// Builds the elastic model a simulator uses; parallel/ provides factories
-// that run the kernels on OpenMP or TBB. The default is make_elastic_operator
-// (serial).
+// Builds the elastic model a simulator uses: a back-end's operator
+// (cpu_operator_factory in edgefem/parallel/cpu_backend.hpp for the CPU
+// back-end). The default is the reference back-end's
+// (make_reference_operator: plain serial loops).
 template <class S>
 using OperatorFactory =
     std::function<std::unique_ptr<ElasticOperator<S>>(const Mesh&, const Materials&, ModelKind, Method)>;
@@ -73,7 +74,7 @@ public:
     // Validates the scene (InvalidArgument naming the field) and sets up the
     // model; the state starts at rest (u = 0, v = 0). `executor` runs the
     // solver's vector operations (serial when null); `factory` builds the
-    // elastic model (serial kernels when empty).
+    // elastic model (the reference back-end's when empty).
     explicit Simulator(Scene scene, std::shared_ptr<const Executor> executor = nullptr,
                        OperatorFactory<S> factory = {});
     ~Simulator();
