@@ -7,7 +7,7 @@
 #include <map>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "cpu/cpu_operator.hpp"

@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "cpu/edge_kernels.hpp"
 #include "cpu/tet_edge_form.hpp"
 #include "cpu/tet_kernels.hpp"

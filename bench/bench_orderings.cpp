@@ -15,7 +15,7 @@
 
 #include "bench_meshes.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "cpu/edge_kernels.hpp"
 #include "cpu/tet_edge_form.hpp"
 #include "edgefem/partition/ordering.hpp"

@@ -20,7 +20,7 @@
 
 #include "bench_meshes.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "cpu/edge_kernels.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "cpu/parallel_edge_kernels.hpp"

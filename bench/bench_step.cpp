@@ -12,9 +12,9 @@
 #include <functional>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "cpu/edge_kernels.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"

@@ -33,11 +33,11 @@
 #include <typeindex>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "cpu/cpu_operator.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "cpu/tet_edge_form.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "cpu/parallel_edge_kernels.hpp"

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/reference_operator.hpp"
 #include "edgefem/core/simulator.hpp"

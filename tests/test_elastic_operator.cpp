@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "edgefem/parallel/cpu_backend.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"

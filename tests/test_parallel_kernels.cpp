@@ -11,7 +11,7 @@
 #include <cstring>
 #include <random>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "cpu/parallel_edge_kernels.hpp"

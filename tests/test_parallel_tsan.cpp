@@ -10,7 +10,7 @@
 #include <cstring>
 #include <thread>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"

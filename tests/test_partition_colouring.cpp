@@ -12,7 +12,7 @@
 
 #include <cstring>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/parallel/executors.hpp"

@@ -16,7 +16,7 @@
 #include "cpu/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/stream_bandwidth.hpp"
+#include "lab/stream_bandwidth.hpp"
 
 using namespace edgefem;
 

@@ -3,7 +3,7 @@
 // against the one-tet kernels they replace for built-in scalars.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
 

@@ -8,7 +8,7 @@
 #include <numeric>
 #include <random>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "cpu/tet_edge_form.hpp"

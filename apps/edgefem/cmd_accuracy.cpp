@@ -36,7 +36,7 @@
 #include "edgefem/parallel/cpu_backend.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
-#include "edgefem/core/named_mesh.hpp"
+#include "lab/named_mesh.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "option_checks.hpp"

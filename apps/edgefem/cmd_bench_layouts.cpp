@@ -35,12 +35,12 @@
 #include <sstream>
 
 #include "common.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "cpu/edge_kernels.hpp"
 #include "edgefem/core/error.hpp"
-#include "edgefem/core/layout_kernels.hpp"
+#include "lab/layout_kernels.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "cpu/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"

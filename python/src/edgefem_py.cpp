@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
