@@ -78,7 +78,7 @@ struct StreamArrays {
 
 void BM_Stream(benchmark::State& state, StreamKernel k, int threads) {
     static StreamArrays arr;
-    const auto ex = make_executor(Backend::OpenMP, threads);
+    const auto ex = make_executor(ExecutorKind::OpenMP, threads);
     double sink = 0;
     const auto t0 = clock_type::now();
     for (auto _ : state) {
@@ -139,7 +139,7 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Variant v, int thr
         k.reset();
         PlanOptions plan;
         plan.stiffness_layout = StiffnessLayout::TsepList;
-        k = std::make_unique<ParallelEdgeKernels<double>>(prepared(mesh).model, make_executor(Backend::OpenMP, threads),
+        k = std::make_unique<ParallelEdgeKernels<double>>(prepared(mesh).model, make_executor(ExecutorKind::OpenMP, threads),
                                                           v, plan);
         key = want;
     }

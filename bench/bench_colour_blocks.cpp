@@ -41,7 +41,7 @@ void BM(benchmark::State& state, std::string name, int threads, index_t block, i
         o.segment_colouring.max_chunk_items = std::max<index_t>(1024, 4 * block);
         o.vertex_colouring.block = std::max<index_t>(1, block / 6);
         o.vertex_colouring.max_chunk_items = std::max<index_t>(170, (4 * block) / 6);
-        op = make_cpu_operator<double>(mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(Backend::TBB, threads), Variant::Colour}, o);
+        op = make_cpu_operator<double>(mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(ExecutorKind::TBB, threads), Variant::Colour}, o);
     }
     const auto u = deformation_displacement(mesh, Deformation::Twist);
     std::vector<double> f(u.size()), y(u.size());

@@ -126,7 +126,7 @@ double flops_of(const flops::Items& n, Kernel k, Which m) {
 std::shared_ptr<const Executor> executor_for(int threads) {
     static std::map<int, std::shared_ptr<const Executor>> cache;
     auto& e = cache[threads];
-    if (!e) e = make_executor(Backend::OpenMP, threads, Schedule::Dynamic);
+    if (!e) e = make_executor(ExecutorKind::OpenMP, threads, Schedule::Dynamic);
     return e;
 }
 

@@ -110,7 +110,7 @@ struct Current {
     std::unique_ptr<ParallelEdgeKernels<double>> k;
 };
 
-ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant v, int threads) {
+ParallelEdgeKernels<double>& kernels(const std::string& mesh, ExecutorKind b, Variant v, int threads) {
     static Current cur;
     const std::string key = mesh + to_string(b) + to_string(v) + std::to_string(threads);
     if (cur.key != key) {
@@ -119,13 +119,13 @@ ParallelEdgeKernels<double>& kernels(const std::string& mesh, Backend b, Variant
         cur.k = std::make_unique<ParallelEdgeKernels<double>>(prepared(mesh).model, make_executor(b, threads), v,
                                                               plan_options(), prepared(mesh).form);
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (v == Variant::Colour && b == Backend::OpenMP && threads == 1)
+        if (v == Variant::Colour && b == ExecutorKind::OpenMP && threads == 1)
             std::fprintf(stderr, "%s colourings (plan %.2f s): vertex segments %s; tsep g %s; tsep K %s; tet-local K %s\n",
                          mesh.c_str(), s, cur.k->vertex_colouring().stats().describe().c_str(),
                          cur.k->tsep_colouring().stats().describe().c_str(),
                          cur.k->stiffness_colouring().stats().describe().c_str(),
                          cur.k->form_colouring().stats().describe().c_str());
-        if (v == Variant::Owner && b == Backend::OpenMP && threads == 1) {
+        if (v == Variant::Owner && b == ExecutorKind::OpenMP && threads == 1) {
             const ForwardSpill &vs = cur.k->vertex_parts(), &es = cur.k->edge_parts();
             std::fprintf(stderr,
                          "%s owner parts: %d; spill windows %.1f%% of the vertices, %.1f%% of the edges; force "
@@ -189,7 +189,7 @@ void BM_Core(benchmark::State& state, std::string mesh, Kernel k) {
     set_counters(state, p, k, form_forces);
 }
 
-void BM_Parallel(benchmark::State& state, std::string mesh, Kernel k, Backend b, Variant v, int threads) {
+void BM_Parallel(benchmark::State& state, std::string mesh, Kernel k, ExecutorKind b, Variant v, int threads) {
     const Prepared& p = prepared(mesh);
     auto& kern = kernels(mesh, b, v, threads);
     std::vector<double> f(p.u.size()), y(p.u.size());
@@ -213,7 +213,7 @@ void BM_Parallel(benchmark::State& state, std::string mesh, Kernel k, Backend b,
 // One semi-implicit step (bench_step's scene, 20 warm-started CG
 // iterations) on the RCM mesh: serial Simulator when `threads` is 0, else
 // the Simulator on the back-end's executor with the variant's operator.
-void BM_Step(benchmark::State& state, std::string mesh, Backend b, Variant v, int threads) {
+void BM_Step(benchmark::State& state, std::string mesh, ExecutorKind b, Variant v, int threads) {
     // Kept while consecutive runs (repetitions) use it: bunny-1m's set-up
     // takes seconds.
     static std::string key;
@@ -243,7 +243,7 @@ void BM_Step(benchmark::State& state, std::string mesh, Backend b, Variant v, in
 // told from the kernels' (Jacobi preconditioner, no product). Serial when
 // `threads` is 0. On a small mesh this is mostly the cost of an
 // iteration's two barriers and its call.
-void BM_Cg(benchmark::State& state, std::string mesh, Backend b, int threads) {
+void BM_Cg(benchmark::State& state, std::string mesh, ExecutorKind b, int threads) {
     const std::size_t n = 3 * std::size_t(prepared(mesh).mesh.num_vertices());
     std::vector<double> d(n), rhs(n), x(n);
     std::vector<std::uint8_t> free_dof(n, 1);
@@ -295,7 +295,7 @@ std::vector<int> thread_counts() {
 void BM_Triad(benchmark::State& state, int threads) {
     const std::size_t n = std::size_t(1) << 24;  // 3 x 128 MiB
     static std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
-    const auto ex = make_executor(threads == 1 ? Backend::Serial : Backend::OpenMP, threads, Schedule::Static);
+    const auto ex = make_executor(threads == 1 ? ExecutorKind::Serial : ExecutorKind::OpenMP, threads, Schedule::Static);
     const index_t chunks = 64 * std::max(1, threads);
     const std::size_t chunk = (n + chunks - 1) / chunks;
     const double s = 3.0;
@@ -329,21 +329,21 @@ int main(int argc, char** argv) {
                 ->Unit(benchmark::kMicrosecond)
                 ->UseRealTime();
         benchmark::RegisterBenchmark((std::string("step/serial/core/1/") + mesh).c_str(), BM_Step, std::string(mesh),
-                                     Backend::Serial, Variant::Auto, 0)
+                                     ExecutorKind::Serial, Variant::Auto, 0)
             ->Unit(benchmark::kMicrosecond)
             ->UseRealTime();
         benchmark::RegisterBenchmark((std::string("cg/serial/core/1/") + mesh).c_str(), BM_Cg, std::string(mesh),
-                                     Backend::Serial, 0)
+                                     ExecutorKind::Serial, 0)
             ->Unit(benchmark::kMicrosecond)
             ->UseRealTime();
-        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
             for (int t : threads)
                 benchmark::RegisterBenchmark(
                     (std::string("cg/") + to_string(b) + "/core/" + std::to_string(t) + "/" + mesh).c_str(), BM_Cg,
                     std::string(mesh), b, t)
                     ->Unit(benchmark::kMicrosecond)
                     ->UseRealTime();
-        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
             for (Variant v : kAllVariants)
                 for (int t : threads) {
                     for (Kernel k : {Kernel::Force, Kernel::Stiffness, Kernel::Kx}) {

@@ -95,8 +95,8 @@ PlanOptions plan(const Prepared& p, Units units) {
 // The kernels object of each (mesh, units, threads), built on first use and
 // kept (bunny-1m: about 0.3 GB each), so that repetitions can be interleaved
 // (--benchmark_enable_random_interleaving) without re-colouring.
-const ParallelEdgeKernels<double>& kernels(const std::string& name, Units units, Backend backend, int threads) {
-    static std::map<std::tuple<std::string, Units, Backend, int>, std::unique_ptr<ParallelEdgeKernels<double>>> cache;
+const ParallelEdgeKernels<double>& kernels(const std::string& name, Units units, ExecutorKind backend, int threads) {
+    static std::map<std::tuple<std::string, Units, ExecutorKind, int>, std::unique_ptr<ParallelEdgeKernels<double>>> cache;
     auto& slot = cache[{name, units, backend, threads}];
     if (!slot) {
         const Prepared& p = prepared(name);
@@ -106,11 +106,11 @@ const ParallelEdgeKernels<double>& kernels(const std::string& name, Units units,
     return *slot;
 }
 
-void BM(benchmark::State& state, std::string name, int kernel, Backend backend, int threads, Units units) {
+void BM(benchmark::State& state, std::string name, int kernel, ExecutorKind backend, int threads, Units units) {
     const Prepared& p = prepared(name);
     std::vector<double> f(p.u.size()), y(p.u.size());
     EdgeState<double> st;
-    if (backend == Backend::Serial) {
+    if (backend == ExecutorKind::Serial) {
         for (auto _ : state) {
             if (kernel == 0)
                 edge_forces<ModelKind::FE, false>(p.model, p.u.data(), f.data(), st);
@@ -146,12 +146,12 @@ int main(int argc, char** argv) {
     for (std::string mesh : bench::kBenchMeshes) {
         for (int k = 0; k < 2; ++k)
             benchmark::RegisterBenchmark((std::string(kernel_names[k]) + "/" + mesh + "/serial").c_str(), BM, mesh, k,
-                                         Backend::Serial, 0, Units::B1)
+                                         ExecutorKind::Serial, 0, Units::B1)
                 ->UseRealTime();
         // OpenMP at 1 and 2 threads; TBB at 2 threads as a cross-check (its
         // arena degrades more gracefully than OpenMP's barriers when the
         // second core is taken by another process).
-        const std::pair<Backend, int> runs[] = {{Backend::OpenMP, 1}, {Backend::OpenMP, 2}, {Backend::TBB, 2}};
+        const std::pair<ExecutorKind, int> runs[] = {{ExecutorKind::OpenMP, 1}, {ExecutorKind::OpenMP, 2}, {ExecutorKind::TBB, 2}};
         for (Units units : {Units::B1, Units::B1024, Units::Parts})
             for (auto [backend, t] : runs)
                 for (int k = 0; k < 2; ++k)

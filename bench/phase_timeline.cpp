@@ -155,7 +155,7 @@ std::string demangled(const std::type_index& t) {
 
 // `calls` steps (after 20 to warm up), then the wall time per step of every
 // call site, largest first.
-int step_sites(const Mesh& mesh, const std::string& name, Backend b, int threads, int calls) {
+int step_sites(const Mesh& mesh, const std::string& name, ExecutorKind b, int threads, int calls) {
     auto tracer = std::make_shared<TracingExecutor>(make_executor(b, threads));
     Scene scene = step_benchmark_scene(mesh, Materials(Material{1e5, 0.3, 1000}));
     scene.solver.cg_fixed_iterations = 20;
@@ -205,9 +205,9 @@ int main(int argc, char** argv) {
         else if (a == "--barriers") barriers = true;
         else usage("unknown argument '" + a + "'");
     }
-    Backend b;
+    ExecutorKind b;
     try {
-        b = parse_backend(backend);
+        b = parse_executor_kind(backend);
     } catch (const std::exception& e) {
         usage(e.what());
     }

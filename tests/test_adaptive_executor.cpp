@@ -57,7 +57,7 @@ TEST(AdaptiveExecutor, EveryChunkOnceAndPhasesInOrder) {
     const std::vector<index_t> chunks{3, 0, 1, 16, 2};
     std::vector<index_t> first{0};
     for (index_t n : chunks) first.push_back(first.back() + n);
-    for (Backend b : {Backend::OpenMP, Backend::TBB})
+    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB})
         for (int t : {2, 3}) {
             const AdaptiveExecutor ex(make_executor(b, t), 2);
             // Past the trial calls, so both modes run.
@@ -221,7 +221,7 @@ TEST(AdaptiveExecutor, SimulatorStepsBitwiseUnchanged) {
         scene.method = method;
         for (Variant var : {Variant::Auto, Variant::Colour, Variant::Gather})
             for (int t : {2, 3}) {
-                const auto plain = make_executor(Backend::OpenMP, t);
+                const auto plain = make_executor(ExecutorKind::OpenMP, t);
                 const auto adaptive = std::make_shared<AdaptiveExecutor>(plain, 1);
                 Simulator<double> a(scene, plain, cpu_operator_factory<double>({plain, var}));
                 Simulator<double> b(scene, adaptive, cpu_operator_factory<double>({adaptive, var}));
@@ -248,13 +248,13 @@ TEST(AdaptiveExecutor, SimulatorStepsBitwiseUnchanged) {
 
 TEST(AdaptiveExecutor, BadArguments) {
     EXPECT_THROW(AdaptiveExecutor(nullptr), InvalidArgument);
-    EXPECT_THROW(AdaptiveExecutor(make_executor(Backend::OpenMP, 2), 0), InvalidArgument);
-    EXPECT_THROW(AdaptiveExecutor(make_executor(Backend::OpenMP, 2), 3, 0), InvalidArgument);
-    EXPECT_THROW(make_adaptive(make_executor(Backend::OpenMP, 2), -1), InvalidArgument);
+    EXPECT_THROW(AdaptiveExecutor(make_executor(ExecutorKind::OpenMP, 2), 0), InvalidArgument);
+    EXPECT_THROW(AdaptiveExecutor(make_executor(ExecutorKind::OpenMP, 2), 3, 0), InvalidArgument);
+    EXPECT_THROW(make_adaptive(make_executor(ExecutorKind::OpenMP, 2), -1), InvalidArgument);
     // One thread: nothing to choose, the executor itself comes back.
-    const auto serial = make_executor(Backend::Serial);
+    const auto serial = make_executor(ExecutorKind::Serial);
     EXPECT_EQ(make_adaptive(serial).get(), serial.get());
-    const auto two = make_executor(Backend::TBB, 2);
+    const auto two = make_executor(ExecutorKind::TBB, 2);
     const auto wrapped = make_adaptive(two);
     EXPECT_NE(wrapped.get(), two.get());
     EXPECT_EQ(wrapped->threads(), 2);

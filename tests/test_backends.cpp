@@ -79,11 +79,11 @@ std::vector<Config> cpu_configs() {
     for (StiffnessLayout layout : {StiffnessLayout::TetLocal, StiffnessLayout::TsepList}) {
         const std::string l = std::string("/") + to_string(layout);
         c.push_back({"serial-loops" + l, {nullptr, Variant::Auto, layout}});
-        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
             for (int t : {1, 2, 3})
                 for (Variant v : {Variant::Auto, Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private,
                                   Variant::Owner}) {
-                    if (b != Backend::OpenMP && v != Variant::Auto && t != 2) continue;  // keep the matrix small
+                    if (b != ExecutorKind::OpenMP && v != Variant::Auto && t != 2) continue;  // keep the matrix small
                     c.push_back({std::string(to_string(b)) + "-" + std::to_string(t) + "-" + to_string(v) + l,
                                  {make_executor(b, t), v, layout}});
                 }
@@ -105,7 +105,9 @@ void expect_close(const Outputs& got, const Outputs& ref, double tol, const std:
     EXPECT_LE(rel_max(got.f, ref.f), tol) << what << " forces";
     EXPECT_LE(rel_max(got.Kx, ref.Kx), tol) << what << " K x";
     EXPECT_LE(rel_max(got.D, ref.D), tol) << what << " diagonal blocks";
-    if (!ref.Kx_definite.empty()) EXPECT_LE(rel_max(got.Kx_definite, ref.Kx_definite), tol) << what << " definite K x";
+    if (!ref.Kx_definite.empty()) {
+        EXPECT_LE(rel_max(got.Kx_definite, ref.Kx_definite), tol) << what << " definite K x";
+    }
 }
 
 std::vector<double> direction(std::size_t n) {
@@ -133,7 +135,7 @@ TEST(Backends, CpuOperatorsMatchTheReference) {
                 expect_close(evaluate(*op, u, x, edge), ref, 1e-12, what);
             }
             // Float on the serial loops and the default threaded variant.
-            for (const CpuOptions& o : {CpuOptions{}, CpuOptions{make_executor(Backend::OpenMP, 2)}}) {
+            for (const CpuOptions& o : {CpuOptions{}, CpuOptions{make_executor(ExecutorKind::OpenMP, 2)}}) {
                 auto op = make_cpu_operator<float>(nm.mesh, material(), c.model, c.method, o);
                 expect_close(evaluate(*op, u, x, edge), ref, 1e-5, std::string(c.name) + " float");
             }
@@ -169,7 +171,7 @@ TEST(Backends, SimulationsMatchTheReference) {
         Simulator<double> ref(scene);
         for (int k = 0; k < steps; ++k) ref.step();
         const std::vector<double> u_ref(ref.displacement().begin(), ref.displacement().end());
-        for (const CpuOptions& o : {CpuOptions{}, CpuOptions{make_executor(Backend::Pool, 2)}}) {
+        for (const CpuOptions& o : {CpuOptions{}, CpuOptions{make_executor(ExecutorKind::Pool, 2)}}) {
             Simulator<double> sim(scene, o.executor, cpu_operator_factory<double>(o));
             for (int k = 0; k < steps; ++k) sim.step();
             const std::vector<double> u(sim.displacement().begin(), sim.displacement().end());

@@ -19,11 +19,11 @@
 using namespace edgefem;
 
 TEST(Executors, EveryChunkOnce) {
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
+    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (int t : {1, 2, 3, 8})
             for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
                 const auto ex = make_executor(b, t, s);
-                EXPECT_EQ(ex->threads(), b == Backend::Serial ? 1 : t);
+                EXPECT_EQ(ex->threads(), b == ExecutorKind::Serial ? 1 : t);
                 for (index_t n : {0, 1, 2, 7, 1000}) {
                     std::vector<std::atomic<int>> hits(n);
                     ex->for_chunks(n, [&](index_t c) { hits[c].fetch_add(1); });
@@ -39,7 +39,7 @@ TEST(Executors, PhasesRunOnceAndInOrder) {
     const std::vector<index_t> chunks{3, 0, 1, 16, 2, 5};
     std::vector<index_t> first{0};  // the offsets for_phases takes
     for (index_t n : chunks) first.push_back(first.back() + n);
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
+    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (int t : {1, 2, 3, 8})
             for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
                 const auto ex = make_executor(b, t, s);
@@ -72,7 +72,7 @@ TEST(Executors, LinkedPhasesHonourTheirLinks) {
     for (index_t c = 0; c < n; ++c) first.push_back(c), last.push_back(std::min<index_t>(c + 1, n - 1));
     for (index_t c = 0; c < n; ++c) first.push_back(0), last.push_back(c);
     for (index_t c = 0; c < n; ++c) first.push_back(-5), last.push_back(n + 5);
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
+    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (int t : {1, 2, 3, 8}) {
             const auto ex = make_executor(b, t);
             for (int call = 0; call < 3; ++call) {  // the pool counts on from call to call
@@ -104,7 +104,7 @@ TEST(Executors, LinkedPhasesHonourTheirLinks) {
 // would hold back until the wait timed out.
 TEST(Executors, LinkedPhasesHaveNoBarrier) {
     const index_t first[] = {0, 1}, last[] = {0, 1};
-    for (Backend b : {Backend::OpenMP, Backend::Pool}) {
+    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::Pool}) {
         const auto ex = make_executor(b, 2);
         std::atomic<bool> ran{false}, seen{false};
         ex->for_linked_phases(2, 2, first, last, [&](int p, index_t c) {
@@ -124,7 +124,7 @@ TEST(Executors, BlockedSumIndependentOfThreads) {
     std::vector<double> a(n);
     for (std::size_t i = 0; i < n; ++i) a[i] = std::sin(0.37 * double(i)) * std::exp(double(i % 97) / 7);
     const double ref = blocked_sum(SerialExecutor{}, n, [&](std::size_t i) { return a[i]; });
-    for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (int t : edgefem::test::test_thread_counts()) {
             const auto ex = make_executor(b, t);
             EXPECT_EQ(blocked_sum(*ex, n, [&](std::size_t i) { return a[i]; }), ref);
@@ -138,7 +138,7 @@ TEST(Executors, ForBlocksVisitEveryIndexOnce) {
     const std::size_t B = kVectorBlock;
     for (std::size_t n : {std::size_t(0), std::size_t(1), B - 1, B, B + 1, kMinParallelBlocks * B - 1,
                           kMinParallelBlocks * B, kMinParallelBlocks * B + 7, std::size_t(100003)})
-        for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool})
+        for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
             for (Schedule sc : {Schedule::Static, Schedule::Dynamic})
                 for (int t : {1, 2, 3, 8}) {
                     const auto ex = make_executor(b, t, sc);
@@ -205,7 +205,7 @@ TEST(Executors, ConjugateGradientSameBitsOnEveryExecutor) {
         }
     }
     EXPECT_LT(worst, 1e-9 * bmax);
-    for (Backend bk : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+    for (ExecutorKind bk : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (Schedule sc : {Schedule::Static, Schedule::Dynamic})
             for (int t : {1, 2, 3, 8}) {
                 std::vector<double> x;
@@ -219,7 +219,7 @@ TEST(Executors, ConjugateGradientSameBitsOnEveryExecutor) {
 // The barrier probe runs on every executor, and says what is wrong with
 // its arguments.
 TEST(Executors, PhaseBarrierProbe) {
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool}) {
+    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool}) {
         const auto ex = make_executor(b, 2);
         const double us = phase_barrier_us(*ex, 50, 3);
         EXPECT_TRUE(std::isfinite(us) && us >= 0) << to_string(b) << " " << us;
@@ -229,37 +229,37 @@ TEST(Executors, PhaseBarrierProbe) {
 }
 
 TEST(Executors, Names) {
-    EXPECT_EQ(parse_backend("serial"), Backend::Serial);
-    EXPECT_EQ(parse_backend("omp"), Backend::OpenMP);
-    EXPECT_EQ(parse_backend("openmp"), Backend::OpenMP);
-    EXPECT_EQ(parse_backend("tbb"), Backend::TBB);
-    EXPECT_THROW(parse_backend("cuda"), InvalidArgument);
-    for (Backend b : {Backend::Serial, Backend::OpenMP, Backend::TBB, Backend::Pool}) EXPECT_EQ(parse_backend(to_string(b)), b);
+    EXPECT_EQ(parse_executor_kind("serial"), ExecutorKind::Serial);
+    EXPECT_EQ(parse_executor_kind("omp"), ExecutorKind::OpenMP);
+    EXPECT_EQ(parse_executor_kind("openmp"), ExecutorKind::OpenMP);
+    EXPECT_EQ(parse_executor_kind("tbb"), ExecutorKind::TBB);
+    EXPECT_THROW(parse_executor_kind("cuda"), InvalidArgument);
+    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool}) EXPECT_EQ(parse_executor_kind(to_string(b)), b);
     for (Variant v : kAllVariants)
         EXPECT_EQ(parse_variant(to_string(v)), v);
     EXPECT_EQ(parse_variant("color"), Variant::Colour);
     EXPECT_THROW(parse_variant("mutex"), InvalidArgument);
     EXPECT_EQ(parse_schedule("static"), Schedule::Static);
-    EXPECT_STREQ(make_executor(Backend::TBB, 2)->name(), "tbb");
-    EXPECT_STREQ(make_executor(Backend::OpenMP, 2)->name(), "omp");
-    EXPECT_EQ(parse_backend("pool"), Backend::Pool);
-    EXPECT_STREQ(make_executor(Backend::Pool, 2)->name(), "pool");
+    EXPECT_STREQ(make_executor(ExecutorKind::TBB, 2)->name(), "tbb");
+    EXPECT_STREQ(make_executor(ExecutorKind::OpenMP, 2)->name(), "omp");
+    EXPECT_EQ(parse_executor_kind("pool"), ExecutorKind::Pool);
+    EXPECT_STREQ(make_executor(ExecutorKind::Pool, 2)->name(), "pool");
 }
 
 // OpenMP starts as many threads as asked (1e5 crashed in libgomp): past
 // kMaxThreads both back-ends refuse; oversubscription below it is fine.
 TEST(Executors, ThreadLimit) {
-    for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool}) {
+    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool}) {
         EXPECT_THROW(make_executor(b, kMaxThreads + 1), InvalidArgument) << to_string(b);
         EXPECT_THROW(make_executor(b, 100000), InvalidArgument) << to_string(b);
         EXPECT_EQ(make_executor(b, 16)->threads(), 16) << to_string(b);
     }
-    EXPECT_NO_THROW(make_executor(Backend::Serial, 100000));  // serial ignores the count
+    EXPECT_NO_THROW(make_executor(ExecutorKind::Serial, 100000));  // serial ignores the count
 }
 
 // Two TBB executors with different thread counts coexist (each its arena).
 TEST(Executors, IndependentArenas) {
-    const auto a = make_executor(Backend::TBB, 2), b = make_executor(Backend::TBB, 3);
+    const auto a = make_executor(ExecutorKind::TBB, 2), b = make_executor(ExecutorKind::TBB, 3);
     std::atomic<int> n{0};
     a->for_chunks(10, [&](index_t) { b->for_chunks(5, [&](index_t) { n.fetch_add(1); }); });
     EXPECT_EQ(n.load(), 50);
@@ -270,7 +270,7 @@ TEST(Executors, IndependentArenas) {
 // turns, and an exception from a chunk comes back to the caller, with every
 // thread past every barrier (the pool stays usable).
 TEST(Executors, PoolNestingConcurrencyExceptions) {
-    const auto pool = make_executor(Backend::Pool, 3);
+    const auto pool = make_executor(ExecutorKind::Pool, 3);
     std::atomic<int> n{0};
     pool->for_chunks(10, [&](index_t) { pool->for_chunks(5, [&](index_t) { n.fetch_add(1); }); });
     EXPECT_EQ(n.load(), 50);
@@ -292,7 +292,7 @@ TEST(Executors, PoolNestingConcurrencyExceptions) {
     for (const auto& h : hits) EXPECT_EQ(h.load(), 20);
 
     for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
-        const auto ex = make_executor(Backend::Pool, 3, s);
+        const auto ex = make_executor(ExecutorKind::Pool, 3, s);
         EXPECT_THROW(ex->for_chunks(100, [](index_t c) {
             if (c == 57) throw InvalidArgument("chunk 57");
         }), InvalidArgument);

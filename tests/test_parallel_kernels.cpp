@@ -44,7 +44,7 @@ struct NamedExecutor {
 const std::vector<NamedExecutor>& executors() {
     static const auto list = [] {
         std::vector<NamedExecutor> v;
-        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
             for (int t : edgefem::test::test_thread_counts())
                 for (Schedule s : {Schedule::Dynamic, Schedule::Static}) {
                     if (s == Schedule::Static && t != 3) continue;  // one static run per backend
@@ -248,7 +248,7 @@ TEST(ParallelEdgeKernels, AutoPicksOwnerWithLocalityAndGatherWithout) {
         const auto models = edgefem::test::make_models<double>(*mesh);
         const auto u = deformation_displacement(*mesh, Deformation::Twist);
         const auto x = deformation_displacement(*mesh, Deformation::Random);
-        const auto ex = make_executor(Backend::OpenMP, 2);
+        const auto ex = make_executor(ExecutorKind::OpenMP, 2);
         const ParallelEdgeKernels<double> k(models.edge, ex, Variant::Auto);
         EXPECT_EQ(k.variant(), expected);
         expect_bitwise(run_parallel<ModelKind::FE>(models.edge, ex, Variant::Auto, u, x),

@@ -64,7 +64,7 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
             const std::string tag = std::string(method == Method::Edge ? "edge/" : "tet/") + to_string(var);
             EXPECT_LE(rel_diff(serial.u, core.u), 1e-12) << tag;
             EXPECT_LE(rel_diff(serial.v, core.v), 1e-12) << tag;
-            for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+            for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
                 for (int t : edgefem::test::test_thread_counts()) {
                     const auto ex = make_executor(b, t);
                     const Result par = run(method, ex, cpu_operator_factory<double>({ex, var}));
@@ -85,7 +85,7 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
 
 TEST(ParallelSimulator, InvertedTetCount) {
     Scene s = cantilever(Method::Edge);
-    const auto ex = make_executor(Backend::TBB, 3);
+    const auto ex = make_executor(ExecutorKind::TBB, 3);
     std::vector<double> u(s.mesh.X.size(), 0.0);
     // Collapse a few vertices onto the origin: inverts or flattens some tets.
     for (int v = 0; v < 20; ++v)
@@ -108,7 +108,7 @@ TEST(ParallelSimulator, InvertedTetCount) {
     std::vector<double> scratch;
     const std::vector<float> uf(u.begin(), u.end());
     for (int threads : {1, 2, 4}) {
-        const auto omp = make_executor(Backend::OpenMP, threads);
+        const auto omp = make_executor(ExecutorKind::OpenMP, threads);
         EXPECT_EQ(count_inverted_tets_parallel(*omp, s.mesh, u.data(), scratch), index_t(serial));
         EXPECT_EQ(count_inverted_tets_parallel(*omp, s.mesh, uf.data(), scratch), count_inverted_tets(s.mesh, uf.data()));
     }
@@ -142,7 +142,7 @@ TEST(ParallelSimulator, ImplicitAndStaticDeterministic) {
         const auto serial_ex = std::make_shared<SerialExecutor>();
         const std::vector<double> serial = run_both(serial_ex, cpu_operator_factory<double>({serial_ex, var}));
         EXPECT_LE(rel_diff(serial, core), 1e-9) << to_string(var);
-        for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
             for (int t : edgefem::test::test_thread_counts()) {
                 const auto ex = make_executor(b, t);
                 EXPECT_TRUE(same(run_both(ex, cpu_operator_factory<double>({ex, var})), serial))

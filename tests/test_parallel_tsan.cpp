@@ -150,7 +150,7 @@ TEST(ParallelTsan, PoolExecutor) {
         std::vector<std::vector<double>> u;
         for (int threads : {1, 3}) {
             for (Schedule sched : {Schedule::Dynamic, Schedule::Static}) {
-                const auto ex = make_executor(Backend::Pool, threads, sched);
+                const auto ex = make_executor(ExecutorKind::Pool, threads, sched);
                 Simulator<double> sim(s, ex, cpu_operator_factory<double>({ex, v}));
                 sim.step();
                 sim.step();
@@ -172,7 +172,7 @@ TEST(ParallelTsan, PoolExecutor) {
 TEST(ParallelTsan, PoolNewton) {
     std::vector<std::vector<double>> out;
     for (int threads : {1, 3}) {
-        const auto ex = make_executor(Backend::Pool, threads);
+        const auto ex = make_executor(ExecutorKind::Pool, threads);
         Scene s = edgefem::test::clamped_box_scene(5, 2, 2);
         s.integrator = Integrator::Implicit;
         s.dt = 2e-3;
@@ -203,7 +203,7 @@ TEST(ParallelTsan, PoolLinkedPhases) {
             last.push_back(p % 2 ? std::min<index_t>(n - 1, c + 2) : c);
         }
     for (int threads : {2, 3, 4}) {
-        const auto ex = make_executor(Backend::Pool, threads);
+        const auto ex = make_executor(ExecutorKind::Pool, threads);
         for (int call = 1; call <= 5; ++call) {
             std::vector<long> value(std::size_t(phases) * n, 0);
             std::atomic<int> wrong{0};

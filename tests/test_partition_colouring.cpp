@@ -277,7 +277,7 @@ TEST(PartitionColouring, VariableUnitsEqualToBlocksColourLikeBlocks) {
 
 TEST(PartitionColouring, KernelsMatchCoreAndAreBitwiseEqualAcrossThreads) {
     std::vector<std::pair<std::string, std::shared_ptr<const Executor>>> executors;
-    for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (int t : {1, 2, 3, 4}) executors.emplace_back(std::string(to_string(b)) + "-" + std::to_string(t), make_executor(b, t));
     for (const auto& pm : part_meshes()) {
         const auto models = test::make_models<double>(pm.mesh);
@@ -318,7 +318,7 @@ TEST(PartitionColouring, ParallelOperatorTakesPartUnitsThroughPlanOptions) {
     ref->build_stiffness(false);
     ref->multiply(u.data(), y_ref.data());
     for (int threads : {1, 2}) {
-        auto op = make_cpu_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(Backend::OpenMP, threads), Variant::Colour}, opts);
+        auto op = make_cpu_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(ExecutorKind::OpenMP, threads), Variant::Colour}, opts);
         op->forces(u.data(), f.data(), false);
         op->build_stiffness(false);
         op->multiply(u.data(), y.data());
@@ -328,6 +328,6 @@ TEST(PartitionColouring, ParallelOperatorTakesPartUnitsThroughPlanOptions) {
     // Parts of another mesh do not fit: rejected when the plan is built.
     PlanOptions wrong = opts;
     wrong.vertex_colouring.unit_first.back() += 1;
-    EXPECT_THROW(make_cpu_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(Backend::OpenMP, 1), Variant::Colour}, wrong),
+    EXPECT_THROW(make_cpu_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(ExecutorKind::OpenMP, 1), Variant::Colour}, wrong),
                  InvalidArgument);
 }

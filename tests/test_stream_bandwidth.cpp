@@ -23,8 +23,8 @@ using namespace edgefem;
 namespace {
 
 std::vector<std::shared_ptr<const Executor>> executors() {
-    return {make_executor(Backend::Serial), make_executor(Backend::OpenMP, 1), make_executor(Backend::OpenMP, 2),
-            make_executor(Backend::OpenMP, 3), make_executor(Backend::TBB, 2)};
+    return {make_executor(ExecutorKind::Serial), make_executor(ExecutorKind::OpenMP, 1), make_executor(ExecutorKind::OpenMP, 2),
+            make_executor(ExecutorKind::OpenMP, 3), make_executor(ExecutorKind::TBB, 2)};
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ namespace {
 struct BenchOptions {
     MeshOptions mesh;
     ModelOptions model;
-    ExecOptions exec;
+    RunOptions run;
     std::string kernel;
     double seconds = 1.0;
     int cg_iters = 0;  // step: > 0 runs exactly this many CG iterations
@@ -55,7 +55,7 @@ void print_header(const BenchOptions& opts, const Mesh& mesh) {
     print_kv("model", opts.model.model);
     print_kv("precision", opts.model.precision);
     print_kv("layout", opts.model.layout);
-    print_kv("backend", opts.exec.describe());
+    print_kv("backend", describe(opts.run, make_run_executor(opts.run).get()));
 }
 
 // The executor's threads themselves: the barrier probe and the triad time
@@ -65,14 +65,20 @@ const Executor& threads_of(const Executor& ex) {
     return ex;
 }
 
+// The executor the STREAM triad runs on: the run's, one thread for the
+// serial loops.
+std::shared_ptr<const Executor> stream_executor(const RunOptions& run) {
+    auto ex = make_run_executor(run);
+    return ex ? ex : std::make_shared<SerialExecutor>();
+}
+
 // On more than one thread, what a phase boundary costs right before and
 // after the timed calls (barrier_latency.hpp says why).
 struct BarrierProbe {
     std::shared_ptr<const Executor> ex;
     bool on;
     double before = 0, after = 0;
-    BarrierProbe(const ExecOptions& exec, std::shared_ptr<const Executor> e)
-        : ex(std::move(e)), on(exec.parallel_kernels() && ex->threads() > 1) {
+    explicit BarrierProbe(std::shared_ptr<const Executor> e) : ex(std::move(e)), on(ex && ex->threads() > 1) {
         if (on) before = phase_barrier_us(threads_of(*ex));
     }
     void finish() {
@@ -94,11 +100,11 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     scene.method = opts.model.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
     scene.solver.cg_tolerance = 1e-6;
     scene.solver.cg_fixed_iterations = opts.cg_iters;
-    const auto ex = opts.exec.executor();
-    Simulator<S> sim(std::move(scene), ex, operator_factory<S>(opts.exec, ex, opts.model.layout_kind()));
+    const auto ex = make_run_executor(opts.run);
+    Simulator<S> sim(std::move(scene), ex, operator_factory<S>(opts.run, ex, opts.model.layout_kind()));
 
     std::vector<int> iterations;  // of the timed calls (cleared after the warm-up, so bounded as they are)
-    BarrierProbe probe(opts.exec, ex);
+    BarrierProbe probe(ex);
     const std::vector<double> ns =
         time_calls(opts.seconds, [&] { iterations.push_back(sim.step().solver_iterations); }, 5, kMaxTimedCalls,
                    [&] { iterations.clear(); });
@@ -117,7 +123,7 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     print_kv("cg_iterations", fmt(mean_iterations, 6));
     print_kv("cg_iterations_max", *std::max_element(iterations.begin(), iterations.end()));
     probe.print();
-    print_adaptive(*ex);
+    if (ex) print_adaptive(*ex);
 }
 
 // Bytes one call of `kernel` moves (compulsory and per-pass counts,
@@ -178,7 +184,7 @@ void run_bench(const BenchOptions& opts) {
     }
     const Kernel kernel = kKernels.at(opts.kernel);
     const Mesh& mesh = lm.mesh;
-    auto eval = make_evaluator(mesh, opts.model, opts.exec);
+    auto eval = make_evaluator(mesh, opts.model, opts.run);
     eval->set_displacement(deformation_displacement(mesh, Deformation::Twist));
     // kx multiplies a generic (non-smooth) vector.
     eval->prepare(kernel, deformation_displacement(mesh, Deformation::Random));
@@ -196,7 +202,7 @@ void run_bench(const BenchOptions& opts) {
     // seconds, so each round's calls are set against the triad measured
     // right after them, and the median of those paired fractions is
     // reported next to the fraction of the overall medians.
-    BarrierProbe probe(opts.exec, opts.exec.executor());
+    BarrierProbe probe(make_run_executor(opts.run));
     const int rounds = opts.stream ? opts.stream_rounds : 1;
     std::vector<double> ns, round_fraction;
     std::vector<StreamBandwidth> sb;
@@ -206,7 +212,7 @@ void run_bench(const BenchOptions& opts) {
         if (opts.stream) {
             StreamOptions so;
             so.repetitions = 3;
-            sb.push_back(measure_stream_bandwidth(threads_of(*opts.exec.executor()), so));
+            sb.push_back(measure_stream_bandwidth(threads_of(*stream_executor(opts.run)), so));
             round_fraction.push_back(traffic.compulsory / median_of_sorted(t) / sb.back().triad);
         }
         ns.insert(ns.end(), t.begin(), t.end());
@@ -274,10 +280,11 @@ void add_bench_command(CLI::App& app) {
         "calls until --seconds have passed (at least 5, at most 2^22 = 4194304 timed calls: timing stops there on tiny meshes); reports the median and minimum per call and per tet, and for the edge method's force and kx the "
         "bytes a call moves from memory (bytes_per_call) and the rate achieved (achieved_GB_per_s); on more than one thread, what an "
         "empty phase boundary costs before and after the timed calls (phase_barrier_us_before/after: where the threads sit)");
-    opts->mesh.ordering = "rcm";  // the measured winner (docs/layouts.md), as simulate and static
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/false);
-    add_exec_options(*cmd, opts->exec);
+    // A benchmark times the back-end it is given: no adaptive choice unless asked.
+    opts->run.adaptive = false;
+    add_run_options(*cmd, opts->run);
     cmd->add_option("--kernel", opts->kernel,
                     "force: forces only (no energy); stiffness: K from a previous force call's state (edge) or "
                     "the per-tet 12x12 blocks (tet); force+stiffness: both; kx: y = K x with K precomputed "

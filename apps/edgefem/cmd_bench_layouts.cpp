@@ -151,15 +151,15 @@ double operator_bytes(const Mesh& mesh, const Topology& topo, const EdgeModel<do
 }
 
 template <class S>
-double step_ns_per_tet(const Mesh& mesh, const ModelOptions& model, const ExecOptions& exec, const Timer& t) {
-    const auto ex = exec.executor();
-    Simulator<S> sim(step_benchmark_scene(mesh, model.material), ex, operator_factory<S>(exec, ex, model.layout_kind()));
+double step_ns_per_tet(const Mesh& mesh, const ModelOptions& model, const RunOptions& run, const Timer& t) {
+    const auto ex = make_run_executor(run);
+    Simulator<S> sim(step_benchmark_scene(mesh, model.material), ex, operator_factory<S>(run, ex, model.layout_kind()));
     return t.ns_per_tet([&] { sim.step(); }, mesh.num_tets());
 }
 
-void measure_operator(const Mesh& mesh, const ModelOptions& model, const ExecOptions& exec, const Timer& t, Row& row) {
+void measure_operator(const Mesh& mesh, const ModelOptions& model, const RunOptions& run, const Timer& t, Row& row) {
     const index_t tets = mesh.num_tets();
-    auto eval = make_evaluator(mesh, model, exec);
+    auto eval = make_evaluator(mesh, model, run);
     eval->set_displacement(deformation_displacement(mesh, Deformation::Twist));
     const std::vector<double> x = deformation_displacement(mesh, Deformation::Random);  // kx: a generic vector
     double* out[3] = {&row.force, &row.K, &row.Kx};
@@ -174,8 +174,8 @@ void measure_operator(const Mesh& mesh, const ModelOptions& model, const ExecOpt
             tets);
     }
     eval.reset();
-    row.step = model.precision_kind() == Precision::Float ? step_ns_per_tet<float>(mesh, model, exec, t)
-                                                          : step_ns_per_tet<double>(mesh, model, exec, t);
+    row.step = model.precision_kind() == Precision::Float ? step_ns_per_tet<float>(mesh, model, run, t)
+                                                          : step_ns_per_tet<double>(mesh, model, run, t);
 }
 
 template <class L>
@@ -481,18 +481,19 @@ void run_bench_layouts(Options opts) {
             std::vector<int> thread_counts = opts.threads;
             if (backend == "serial") thread_counts = {1};
             for (int threads : thread_counts) {
-                ExecOptions exec;
-                exec.backend = backend;
-                exec.threads = threads;
-                exec.variant = opts.variant;
-                exec.variant_given = backend != "serial";
-                const int actual_threads = backend == "serial" ? 1 : exec.executor()->threads();
+                RunOptions run;  // the back-end as asked: no adaptive choice
+                run.backend = backend;
+                run.threads = threads;
+                run.variant = backend == "serial" ? "auto" : opts.variant;
+                run.adaptive = false;
+                const auto run_ex = make_run_executor(run);
+                const int actual_threads = run_ex ? run_ex->threads() : 1;
                 for (const std::string& layout : operator_layouts) {
                     ModelOptions model;
                     model.layout = layout;
                     model.precision = opts.precision;
                     Row row{ordering, layout, backend, actual_threads};
-                    measure_operator(mesh, model, exec, timer, row);
+                    measure_operator(mesh, model, run, timer, row);
                     row.bytes = model.precision_kind() == Precision::Float ? operator_bytes<float>(mesh, topo, md, layout)
                                                                            : operator_bytes<double>(mesh, topo, md, layout);
                     if (backend == "serial") set_misses(row, kEdgeModelId);
@@ -520,6 +521,7 @@ void add_bench_layouts_command(CLI::App& app) {
         "Compare memory layouts: a table of ordering x layout x back-end x threads with the median ns per tet of the "
         "force kernel, the stiffness K, K x and a semi-implicit step, the bytes of precomputed data per tet and, "
         "with --cachegrind, D1 and last-level data-cache misses per tet of the force kernel (docs/layouts.md)");
+    opts->mesh.ordering = "input";  // the mesh as given unless --ordering(s) asks otherwise
     add_mesh_options(*cmd, opts->mesh);
     auto* ordering = cmd->get_option("--ordering");
     cmd->add_option("--orderings", opts->orderings, "Comma-separated vertex orderings, one block of rows each")

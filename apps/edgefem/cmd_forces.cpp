@@ -16,7 +16,7 @@ namespace {
 struct ForcesOptions {
     MeshOptions mesh;
     ModelOptions model;
-    ExecOptions exec;
+    RunOptions run;
     std::string pos, dir, deform, out;
 };
 
@@ -47,7 +47,7 @@ void run_forces(const ForcesOptions& opts) {
     std::vector<double> dir;
     if (!opts.dir.empty()) dir = read_vectors(opts.dir, nv);
 
-    auto eval = make_evaluator(lm.mesh, opts.model, opts.exec);
+    auto eval = make_evaluator(lm.mesh, opts.model, opts.run);
     eval->set_displacement(lm.to_internal(u));
     std::vector<double> f;
     const auto t0 = std::chrono::steady_clock::now();
@@ -98,7 +98,7 @@ void add_forces_command(CLI::App& app) {
     opts->mesh.ordering = "rcm";  // the measured winner (docs/layouts.md), as simulate and static
     add_mesh_options(*cmd, opts->mesh);
     add_model_options(*cmd, opts->model, /*material_required=*/true);
-    add_exec_options(*cmd, opts->exec);
+    add_run_options(*cmd, opts->run);
     // Empty paths would be taken as "not given" (--pos, --dir) or write
     // hidden files (--out "": .energy, .force).
     auto* pos = cmd->add_option("--pos", opts->pos, "Current positions: one 'x y z' line per vertex (default: rest shape)")

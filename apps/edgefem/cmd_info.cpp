@@ -61,6 +61,7 @@ void run_info(const MeshOptions& opts) {
 
 void add_info_command(CLI::App& app) {
     auto opts = std::make_shared<MeshOptions>();
+    opts->ordering = "input";  // describes the mesh as given unless --ordering asks otherwise
     auto* cmd = app.add_subcommand("info", "Print mesh sizes, edge/TSEP counts, model memory and shape statistics");
     add_mesh_options(*cmd, *opts);
     cmd->callback([opts] { run_info(*opts); });

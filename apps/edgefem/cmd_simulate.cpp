@@ -24,12 +24,11 @@ struct SimulateOptions {
     std::string scene;  // empty: the built-in default
     std::string out;    // overrides output.dir
     int steps = -1;     // >= 0 overrides the scene's steps
-    // The internal vertex numbering: RCM by default (the force on bunny-1m
-    // runs 2-2.5x faster than in TetGen's numbering: docs/layouts.md,
-    // "Orderings: bunny-1m force, 1 thread"); frames and messages stay in
-    // the mesh's numbering.
-    std::string ordering = "rcm";
-    ExecOptions exec;
+    // Its ordering is the internal vertex numbering: RCM by default (the
+    // force on bunny-1m runs 2-2.5x faster than in TetGen's numbering:
+    // docs/layouts.md, "Orderings: bunny-1m force, 1 thread"); frames and
+    // messages stay in the mesh's numbering.
+    RunOptions run;
 };
 
 double median(std::vector<double> v) {
@@ -83,9 +82,9 @@ void run_simulate(const SimulateOptions& opts) {
     const OutputSettings out = sf.output;
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
-    const auto executor = opts.exec.executor();
-    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.ordering), executor,
-                                  operator_factory<double>(opts.exec, executor));
+    const auto executor = make_run_executor(opts.run);
+    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering), executor,
+                                  operator_factory<double>(opts.run, executor));
     Simulator<double>& sim = osim.internal();
     const Scene& scene = sf.scene;  // the user's numbering
     const long steps = scene.steps;
@@ -156,7 +155,8 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("vertices", scene.mesh.num_vertices());
     print_kv("tets", scene.mesh.num_tets());
     print_kv("integrator", to_string(scene.integrator));
-    print_kv("ordering", opts.ordering);
+    print_kv("ordering", opts.run.ordering);
+    print_kv("backend", describe(opts.run, executor.get()));
     print_kv("steps", steps);
     print_kv("ms_per_step", fmt(median(step_ms), 6));
     print_kv("force_ms", fmt(median(force_ms), 6));
@@ -168,7 +168,7 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("energy_drift", fmt(e_drift, 6));
     print_kv("inverted_tets", inverted_max);
     if (out.vtu) print_kv("output", (std::filesystem::path(out.dir) / (name + ".pvd")).string());
-    print_adaptive(*executor);
+    if (executor) print_adaptive(*executor);
     print_kv("wall_s", fmt(std::chrono::duration<double>(clock::now() - t_start).count(), 6));
 }
 
@@ -193,9 +193,8 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--steps", opts->steps, "Number of steps (overrides the scene's steps)")
         ->check(int_in_range(0));
     cmd->footer(kExitCodesHelp);
-    add_ordering_option(*cmd, opts->ordering);
-    opts->exec.adaptive = "on";  // a production run: serial when that was faster in sum
-    add_exec_options(*cmd, opts->exec);
+    add_ordering_option(*cmd, opts->run.ordering);
+    add_run_options(*cmd, opts->run);
     cmd->callback([opts] { run_simulate(*opts); });
 }
 

@@ -15,8 +15,7 @@ namespace {
 
 struct StaticOptions {
     std::string scene, out;
-    std::string ordering = "rcm";  // the internal numbering (as simulate's)
-    ExecOptions exec;
+    RunOptions run;  // its ordering: the internal numbering
 };
 
 void run_static(const StaticOptions& opts) {
@@ -26,9 +25,9 @@ void run_static(const StaticOptions& opts) {
     check_writable("--out", opts.out + ".disp");
     check_writable("--out", opts.out + ".vtu");
     SceneFile sf = load_scene_file(opts.scene);
-    const auto executor = opts.exec.executor();
-    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.ordering), executor,
-                                  operator_factory<double>(opts.exec, executor));
+    const auto executor = make_run_executor(opts.run);
+    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering), executor,
+                                  operator_factory<double>(opts.run, executor));
     const Simulator<double>& sim = osim.internal();
     const StaticResult r = osim.solve_static();
 
@@ -40,13 +39,14 @@ void run_static(const StaticOptions& opts) {
 
     print_kv("vertices", sim.num_vertices());
     print_kv("tets", sim.scene().mesh.num_tets());
-    print_kv("ordering", opts.ordering);
+    print_kv("ordering", opts.run.ordering);
+    print_kv("backend", describe(opts.run, executor.get()));
     print_kv("newton_iterations", r.newton_iterations);
     print_kv("load_steps", r.load_steps);
     print_kv("residual", fmt(r.residual, 6));
     print_kv("converged", r.converged ? "true" : "false");
     print_kv("inverted_tets", sim.last_stats().inverted_tets);
-    print_adaptive(*executor);
+    if (executor) print_adaptive(*executor);
     print_kv("wall_s", fmt(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 6));
     // The files are written either way: the last state helps to see why.
     if (!r.converged)
@@ -66,9 +66,8 @@ void add_static_command(CLI::App& app) {
     cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md)")->required()->check(non_empty_path());
     cmd->add_option("--out", opts->out, "Output file prefix")->required()->check(non_empty_path());
     cmd->footer(kExitCodesHelp);
-    add_ordering_option(*cmd, opts->ordering);
-    opts->exec.adaptive = "on";  // a production run: serial when that was faster in sum
-    add_exec_options(*cmd, opts->exec);
+    add_ordering_option(*cmd, opts->run.ordering);
+    add_run_options(*cmd, opts->run);
     cmd->callback([opts] { run_static(*opts); });
 }
 

@@ -160,28 +160,19 @@ void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required
 
 // ---- Execution ------------------------------------------------------------
 
-std::shared_ptr<const Executor> ExecOptions::executor() const {
-    auto ex = make_executor(parse_backend(backend), threads, parse_schedule(schedule));
-    return adaptive == "on" ? make_adaptive(std::move(ex)) : ex;
-}
-
-std::string ExecOptions::describe() const {
-    if (!parallel_kernels()) return "serial";
-    return std::string(backend) + " x" + std::to_string(executor()->threads()) + ", " + variant + ", " + schedule +
-           (adaptive == "on" ? ", adaptive" : "");
-}
-
 void print_adaptive(const Executor& executor) {
     if (const auto* a = dynamic_cast<const AdaptiveExecutor*>(&executor)) print_kv("adaptive", a->summary());
 }
 
-void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
+void add_run_options(CLI::App& cmd, RunOptions& opts, bool with_variant) {
     cmd.add_option("--backend", opts.backend,
-                   "Where the kernels run: serial (core's loops), omp (OpenMP), tbb (oneTBB) or pool (std::threads "
-                   "that spin between calls: no system call per call; docs/parallel.md, \"Back-ends\")")
-        ->check(CLI::IsMember({"serial", "omp", "tbb", "pool"}))
+                   "Where the kernels run: auto (every core: the pool back-end, or serial on one core), serial "
+                   "(the CPU back-end's loops on one thread), omp (OpenMP), tbb (oneTBB), pool (std::threads that "
+                   "spin between calls: no system call per call) or reference (plain loops, the tests' oracle; "
+                   "slow) (docs/parallel.md, \"Back-ends\")")
+        ->check(CLI::IsMember({"auto", "serial", "omp", "tbb", "pool", "reference"}))
         ->capture_default_str();
-    cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb/pool back-end (0: all hardware threads)")
+    cmd.add_option("--threads", opts.threads, "Threads of the auto/omp/tbb/pool back-end (0: all hardware threads)")
         ->check(int_in_range(0))
         ->capture_default_str();
     cmd.add_option("--schedule", opts.schedule,
@@ -191,14 +182,15 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
                    "are always static (docs/parallel.md, \"Schedules\")")
         ->check(CLI::IsMember({"static", "dynamic"}))
         ->capture_default_str();
-    cmd.add_option("--adaptive", opts.adaptive,
-                   "on: the first calls of every loop of the omp/tbb/pool back-end are timed on the threads and on one "
-                   "thread alternately, and all loops then run where they were faster in sum (small meshes, "
-                   "where a barrier costs more than the work it splits, go serial; timed again after 2^14 "
-                   "calls, then 2^15, ...); off: every loop on the threads. Results are identical "
-                   "(docs/parallel.md, \"The adaptive executor\")")
-        ->check(CLI::IsMember({"on", "off"}))
-        ->capture_default_str();
+    auto* adaptive = cmd.add_option_function<std::string>(
+                       "--adaptive", [&opts](const std::string& v) { opts.adaptive = v == "on"; },
+                       "on: the first calls of every loop of the auto/omp/tbb/pool back-end are timed on the threads "
+                       "and on one thread alternately, and all loops then run where they were faster in sum (small "
+                       "meshes, where a barrier costs more than the work it splits, go serial; timed again after "
+                       "2^14 calls, then 2^15, ...); off: every loop on the threads. Results are identical "
+                       "(docs/parallel.md, \"The adaptive executor\")")
+        ->check(CLI::IsMember({"on", "off"}));
+    adaptive->default_str(opts.adaptive ? "on" : "off");
     if (with_variant)
         cmd.add_option("--variant", opts.variant,
                        "How concurrent writes are resolved: auto (owner when the vertex numbering has "
@@ -207,7 +199,6 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
                        "(per-thread accumulators + reduction) or owner (fixed parts of consecutive items, "
                        "writes past a part spilled and added in part order, deterministic)")
             ->check(CLI::IsMember({"auto", "colour", "color", "gather", "atomic", "private", "owner"}))
-            ->each([&opts](const std::string&) { opts.variant_given = true; })
             ->capture_default_str();
 }
 

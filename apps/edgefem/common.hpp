@@ -19,6 +19,7 @@
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"
+#include "edgefem/parallel/run_options.hpp"
 #include "option_checks.hpp"
 
 namespace edgefem::cli {
@@ -29,7 +30,7 @@ struct MeshOptions {
     std::string path;  // file, TetGen prefix or box:NXxNYxNZ
     bool fix_orientation = false;
     bool compact = false;
-    std::string ordering = "input";  // input | random | rcm | morton | nd | metis
+    std::string ordering = RunOptions{}.ordering;  // input | random | rcm | morton | nd | metis
 };
 
 // --ordering NAME into `ordering` (its value on entry is the default).
@@ -91,37 +92,20 @@ void check_mesh_scale(const Mesh& mesh, Precision precision, const std::string& 
 // to the Material defaults (bench).
 void add_model_options(CLI::App& cmd, ModelOptions& opts, bool material_required);
 
-// ---- Execution (parallel back-ends) ----------------------------------------
-
-struct ExecOptions {
-    std::string backend = "serial";  // serial | omp | tbb
-    int threads = 0;                 // 0: all hardware threads
-    std::string variant = "auto";  // auto | colour | gather | atomic | private | owner (docs/parallel.md)
-    bool variant_given = false;      // --variant on the command line
-    std::string schedule = "dynamic";  // static | dynamic (how the kernels' chunks go to threads)
-    // on | off: the loops run serially when their timed first calls were
-    // faster so in sum (AdaptiveExecutor); a command sets its default
-    // before add_exec_options.
-    std::string adaptive = "off";
-
-    // The parallel kernels run unless this is the plain serial default
-    // (--backend serial without --variant: core's serial loops).
-    bool parallel_kernels() const { return backend != "serial" || variant_given; }
-    std::shared_ptr<const Executor> executor() const;
-    // "serial" or e.g. "tbb x2, colour".
-    std::string describe() const;
-};
+// ---- Execution: the run options (edgefem/parallel/run_options.hpp) --------
 
 // With an AdaptiveExecutor: "adaptive: serial|threads (...)", its verdict.
 void print_adaptive(const Executor& executor);
 
-// Adds --backend, --threads, --schedule, --adaptive and (with_variant) --variant.
-void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant = true);
+// Adds --backend, --threads, --schedule, --adaptive and (with_variant)
+// --variant, with the run options' defaults (a command may change them
+// before the call).
+void add_run_options(CLI::App& cmd, RunOptions& run, bool with_variant = true);
 
-// The elastic-model factory a simulator should use under `exec` (empty for
-// core's serial kernels with the default layout), running on `executor`.
+// The elastic-model factory of `run` on `executor` (make_run_executor's),
+// with the FE stiffness layout of --layout.
 template <class S>
-OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor,
+OperatorFactory<S> operator_factory(RunOptions run, const std::shared_ptr<const Executor>& executor,
                                     StiffnessLayout layout = StiffnessLayout::TetLocal);
 
 // The kernels `bench` times (see its --help).
@@ -154,7 +138,7 @@ public:
 
 // Builds the chosen model for `mesh` (opts must be validated) on the chosen
 // back-end (evaluator.cpp).
-std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec);
+std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts, const RunOptions& run);
 
 // ---- Text I/O -------------------------------------------------------------
 

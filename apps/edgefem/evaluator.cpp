@@ -64,29 +64,29 @@ private:
 };
 
 template <class S>
-std::unique_ptr<Evaluator> make_evaluator_as(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec) {
+std::unique_ptr<Evaluator> make_evaluator_as(const Mesh& mesh, const ModelOptions& opts, const RunOptions& run) {
     const edgefem::Method method = opts.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
-    const OperatorFactory<S> factory = operator_factory<S>(exec, exec.executor(), opts.layout_kind());
+    const OperatorFactory<S> factory = operator_factory<S>(run, make_run_executor(run), opts.layout_kind());
     return std::make_unique<OperatorEvaluator<S>>(factory(mesh, opts.material, opts.kind(), method));
 }
 
 }  // namespace
 
-std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec) {
-    if (opts.precision_kind() == Precision::Float) return make_evaluator_as<float>(mesh, opts, exec);
-    return make_evaluator_as<double>(mesh, opts, exec);
+std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& opts, const RunOptions& run) {
+    if (opts.precision_kind() == Precision::Float) return make_evaluator_as<float>(mesh, opts, run);
+    return make_evaluator_as<double>(mesh, opts, run);
 }
 
 template <class S>
-OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor,
+OperatorFactory<S> operator_factory(RunOptions run, const std::shared_ptr<const Executor>& executor,
                                     StiffnessLayout layout) {
-    // The serial loops unless a threaded back-end or a variant is asked for.
-    return cpu_operator_factory<S>({exec.parallel_kernels() ? executor : nullptr, parse_variant(exec.variant), layout});
+    run.layout = to_string(layout);
+    return make_run_factory<S>(run, executor);
 }
 
-template OperatorFactory<double> operator_factory<double>(const ExecOptions&, const std::shared_ptr<const Executor>&,
+template OperatorFactory<double> operator_factory<double>(RunOptions, const std::shared_ptr<const Executor>&,
                                                           StiffnessLayout);
-template OperatorFactory<float> operator_factory<float>(const ExecOptions&, const std::shared_ptr<const Executor>&,
+template OperatorFactory<float> operator_factory<float>(RunOptions, const std::shared_ptr<const Executor>&,
                                                         StiffnessLayout);
 
 }  // namespace edgefem::cli

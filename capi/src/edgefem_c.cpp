@@ -17,6 +17,7 @@
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/validate_mesh.hpp"
+#include "edgefem/parallel/run_options.hpp"
 
 #ifndef EDGEFEM_VERSION
 #define EDGEFEM_VERSION "unknown"
@@ -27,8 +28,9 @@ struct edgefem_scene {
 };
 
 struct edgefem_sim {
-    explicit edgefem_sim(edgefem::Scene s) : sim(std::move(s)) {}
-    edgefem::Simulator<double> sim;
+    explicit edgefem_sim(std::unique_ptr<edgefem::OrderedSimulator<double>> s) : owner(std::move(s)), sim(*owner) {}
+    std::unique_ptr<edgefem::OrderedSimulator<double>> owner;
+    edgefem::OrderedSimulator<double>& sim;
 };
 
 namespace {
@@ -302,12 +304,44 @@ edgefem_status edgefem_scene_set_cg(edgefem_scene* scene, double tolerance, int3
 
 // ---- Simulations ----
 
+void edgefem_run_options_default(edgefem_run_options* out) {
+    if (!out) return;
+    *out = edgefem_run_options{nullptr, 0, nullptr, nullptr, 1, nullptr, nullptr};
+}
+
+namespace {
+edgefem::RunOptions to_run_options(const edgefem_run_options* in) {
+    edgefem::RunOptions run;
+    if (!in) return run;
+    if (in->backend) run.backend = in->backend;
+    run.threads = in->threads;
+    if (in->variant) run.variant = in->variant;
+    if (in->schedule) run.schedule = in->schedule;
+    if (in->adaptive != 0 && in->adaptive != 1)
+        throw edgefem::InvalidArgument("run option adaptive: " + std::to_string(in->adaptive) + " (expected 0 or 1)");
+    run.adaptive = in->adaptive == 1;
+    if (in->ordering) run.ordering = in->ordering;
+    if (in->layout) run.layout = in->layout;
+    edgefem::validate(run);
+    return run;
+}
+}  // namespace
+
+edgefem_status edgefem_sim_create_with(const edgefem_scene* scene, const edgefem_run_options* run, edgefem_sim** out) {
+    if (out) *out = nullptr;
+    return guard("edgefem_sim_create_with", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        *out = new edgefem_sim(edgefem::make_simulator<double>(scene->scene, to_run_options(run)));
+    });
+}
+
 edgefem_status edgefem_sim_create(const edgefem_scene* scene, edgefem_sim** out) {
     if (out) *out = nullptr;
     return guard("edgefem_sim_create", [&] {
         require(scene, "scene");
         require(out, "out");
-        *out = new edgefem_sim(scene->scene);
+        *out = new edgefem_sim(edgefem::make_simulator<double>(scene->scene, {}));
     });
 }
 
@@ -391,7 +425,7 @@ edgefem_status edgefem_sim_get_positions(const edgefem_sim* sim, double* out, si
 
 namespace {
 // The const C handle reads spans the C++ API exposes only as non-const.
-edgefem::Simulator<double>& mut(const edgefem_sim* sim) { return const_cast<edgefem_sim*>(sim)->sim; }
+edgefem::OrderedSimulator<double>& mut(const edgefem_sim* sim) { return const_cast<edgefem_sim*>(sim)->sim; }
 }  // namespace
 
 edgefem_status edgefem_sim_get_displacement(const edgefem_sim* sim, double* out, size_t count) {

@@ -274,7 +274,7 @@ int run(const Options& o) {
 #ifdef EDGEFEM_HAPTIC_HAVE_PARALLEL
     factory = cpu_operator_factory<S>();  // the CPU back-end's serial loops
     if (o.backend != "serial") {
-        executor = make_executor(parse_backend(o.backend), o.threads);
+        executor = make_executor(parse_executor_kind(o.backend), o.threads);
         factory = cpu_operator_factory<S>({executor, parse_variant(o.variant)});
         backend = executor->name();
         threads = executor->threads();

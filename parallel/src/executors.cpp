@@ -21,19 +21,19 @@
 
 namespace edgefem {
 
-Backend parse_backend(std::string_view name) {
-    if (name == "serial") return Backend::Serial;
-    if (name == "omp" || name == "openmp") return Backend::OpenMP;
-    if (name == "tbb") return Backend::TBB;
-    if (name == "pool") return Backend::Pool;
+ExecutorKind parse_executor_kind(std::string_view name) {
+    if (name == "serial") return ExecutorKind::Serial;
+    if (name == "omp" || name == "openmp") return ExecutorKind::OpenMP;
+    if (name == "tbb") return ExecutorKind::TBB;
+    if (name == "pool") return ExecutorKind::Pool;
     throw InvalidArgument("unknown backend '" + std::string(name) + "' (expected serial, omp, tbb or pool)");
 }
 
-const char* to_string(Backend b) {
+const char* to_string(ExecutorKind b) {
     switch (b) {
-        case Backend::Serial: return "serial";
-        case Backend::OpenMP: return "omp";
-        case Backend::Pool: return "pool";
+        case ExecutorKind::Serial: return "serial";
+        case ExecutorKind::OpenMP: return "omp";
+        case ExecutorKind::Pool: return "pool";
         default: return "tbb";
     }
 }
@@ -184,11 +184,11 @@ void TbbExecutor::run_phases(Schedule schedule, int phases, const index_t* chunk
 
 // ---- Factory ------------------------------------------------------------------
 
-std::shared_ptr<const Executor> make_executor(Backend backend, int threads, Schedule schedule) {
+std::shared_ptr<const Executor> make_executor(ExecutorKind backend, int threads, Schedule schedule) {
     switch (backend) {
-        case Backend::Serial: return std::make_shared<SerialExecutor>();
-        case Backend::OpenMP: return std::make_shared<OmpExecutor>(threads, schedule);
-        case Backend::Pool: return std::make_shared<PoolExecutor>(threads, schedule);
+        case ExecutorKind::Serial: return std::make_shared<SerialExecutor>();
+        case ExecutorKind::OpenMP: return std::make_shared<OmpExecutor>(threads, schedule);
+        case ExecutorKind::Pool: return std::make_shared<PoolExecutor>(threads, schedule);
         default: return std::make_shared<TbbExecutor>(threads, schedule);
     }
 }

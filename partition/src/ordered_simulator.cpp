@@ -38,11 +38,31 @@ void gather(std::span<const From> in, std::span<To> out, const std::vector<index
 }
 }  // namespace
 
+namespace {
+// The ordering, or an empty list when it is the identity.
+std::vector<index_t> non_identity(std::vector<index_t> new_of_old) {
+    for (std::size_t v = 0; v < new_of_old.size(); ++v)
+        if (new_of_old[v] != index_t(v)) return new_of_old;
+    return {};
+}
+}  // namespace
+
 template <class S>
 OrderedSimulator<S>::OrderedSimulator(const Scene& scene, Ordering ordering, std::shared_ptr<const Executor> executor,
                                       OperatorFactory<S> factory, const OrderingOptions& options)
-    : new_of_old_((scene.validate(), vertex_ordering(scene.mesh, ordering, options))),
-      sim_(permute_scene(scene, new_of_old_), std::move(executor), std::move(factory)) {}
+    : user_scene_((scene.validate(), scene)),
+      new_of_old_(non_identity(vertex_ordering(scene.mesh, ordering, options))),
+      sim_(identity() ? scene : permute_scene(scene, new_of_old_), std::move(executor), std::move(factory)) {
+    if (identity()) return;
+    const std::size_t n = 3 * new_of_old_.size();
+    u_.assign(n, S(0));
+    v_.assign(n, S(0));
+    fext_.assign(n, S(0));
+    f_.assign(n, S(0));
+    mass_.resize(new_of_old_.size());
+    for (std::size_t v = 0; v < new_of_old_.size(); ++v) mass_[v] = sim_.lumped_mass()[new_of_old_[v]];
+    pull();
+}
 
 namespace {
 // The error with its vertex (and the message's "vertex N") in the user's
@@ -66,53 +86,102 @@ SimulationError to_user_numbering(const SimulationError& e, const std::vector<in
 }  // namespace
 
 template <class S>
+void OrderedSimulator<S>::push() {
+    if (identity()) return;
+    gather<S, S>(u_, sim_.displacement(), new_of_old_, true);
+    gather<S, S>(v_, sim_.velocity(), new_of_old_, true);
+    gather<S, S>(fext_, sim_.external_forces(), new_of_old_, true);
+}
+
+template <class S>
+void OrderedSimulator<S>::pull() {
+    if (identity()) return;
+    gather<S, S>(sim_.displacement(), u_, new_of_old_, false);
+    gather<S, S>(sim_.velocity(), v_, new_of_old_, false);
+    gather<S, S>(sim_.forces(), f_, new_of_old_, false);
+}
+
+template <class S>
 const StepStats& OrderedSimulator<S>::step() {
+    push();
     try {
-        return sim_.step();
+        const StepStats& st = sim_.step();
+        pull();
+        return st;
     } catch (const SimulationError& e) {
+        pull();  // the state before the step (the simulator restored it)
         throw to_user_numbering(e, new_of_old_);
     }
 }
 
 template <class S>
 StaticResult OrderedSimulator<S>::solve_static() {
+    push();
     try {
-        return sim_.solve_static();
+        const StaticResult r = sim_.solve_static();
+        pull();
+        return r;
     } catch (const SimulationError& e) {
+        pull();
         throw to_user_numbering(e, new_of_old_);
     }
 }
 
 template <class S>
+Energies OrderedSimulator<S>::energies() {
+    push();
+    return sim_.energies();
+}
+
+namespace {
+// A user array of `given` values for a view of `expected` (3 #V).
+void check_length(std::size_t given, std::size_t expected) {
+    if (given != expected)
+        throw InvalidArgument("expected 3 x #V = " + std::to_string(expected) + " values (one xyz per vertex), got " +
+                              std::to_string(given));
+}
+template <class From, class To>
+void copy_into_user(std::span<const From> view, std::span<To> out) {
+    check_length(out.size(), view.size());
+    std::copy(view.begin(), view.end(), out.begin());
+}
+template <class From, class To>
+void copy_from_user(std::span<const From> in, std::span<To> view) {
+    check_length(in.size(), view.size());
+    std::copy(in.begin(), in.end(), view.begin());
+}
+}  // namespace
+
+template <class S>
 void OrderedSimulator<S>::get_displacement(std::span<double> out) const {
-    gather<S, double>(const_cast<Simulator<S>&>(sim_).displacement(), out, new_of_old_, false);
+    copy_into_user<S, double>(const_cast<OrderedSimulator&>(*this).displacement(), out);
 }
 template <class S>
 void OrderedSimulator<S>::set_displacement(std::span<const double> in) {
-    gather<double, S>(in, sim_.displacement(), new_of_old_, true);
+    copy_from_user<double, S>(in, displacement());
 }
 template <class S>
 void OrderedSimulator<S>::get_velocity(std::span<double> out) const {
-    gather<S, double>(const_cast<Simulator<S>&>(sim_).velocity(), out, new_of_old_, false);
+    copy_into_user<S, double>(const_cast<OrderedSimulator&>(*this).velocity(), out);
 }
 template <class S>
 void OrderedSimulator<S>::set_velocity(std::span<const double> in) {
-    gather<double, S>(in, sim_.velocity(), new_of_old_, true);
+    copy_from_user<double, S>(in, velocity());
 }
 template <class S>
 void OrderedSimulator<S>::get_forces(std::span<double> out) const {
-    gather<S, double>(sim_.forces(), out, new_of_old_, false);
+    copy_into_user<S, double>(forces(), out);
 }
 template <class S>
 void OrderedSimulator<S>::set_external_forces(std::span<const double> in) {
-    gather<double, S>(in, sim_.external_forces(), new_of_old_, true);
+    copy_from_user<double, S>(in, external_forces());
 }
 template <class S>
 std::vector<double> OrderedSimulator<S>::positions() const {
-    const std::vector<double> internal = sim_.positions();
-    std::vector<double> out(internal.size());
-    gather<double, double>(internal, out, new_of_old_, false);
-    return out;
+    std::vector<double> x(user_scene_.mesh.X);
+    const auto u = const_cast<OrderedSimulator&>(*this).displacement();
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] += double(u[i]);
+    return x;
 }
 
 template class OrderedSimulator<double>;

@@ -22,11 +22,7 @@
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/core/write_vtu.hpp"
-#ifdef EDGEFEM_PY_HAVE_PARALLEL
-#include "edgefem/parallel/adaptive_executor.hpp"
-#include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/cpu_backend.hpp"
-#endif
+#include "edgefem/parallel/run_options.hpp"
 
 namespace py = pybind11;
 using namespace edgefem;
@@ -83,8 +79,8 @@ Mesh mesh_from_arrays(const InArray& X, const InIndex& tets, std::optional<std::
 // The elastic kernels on their own, owning a copy of the mesh (the operator
 // keeps a reference to it).
 struct ElasticModel {
-    ElasticModel(Mesh m, const Materials& mat, ModelKind kind, Method method)
-        : mesh(std::move(m)), op(make_cpu_operator<double>(mesh, mat, kind, method)) {}
+    ElasticModel(Mesh m, const Materials& mat, ModelKind kind, Method method, const RunOptions& run)
+        : mesh(std::move(m)), op(make_run_factory<double>(run, make_run_executor(run))(mesh, mat, kind, method)) {}
     ElasticModel(const ElasticModel&) = delete;
     ElasticModel& operator=(const ElasticModel&) = delete;
     std::size_t dofs() const { return 3 * std::size_t(mesh.num_vertices()); }
@@ -125,18 +121,20 @@ double median(const std::vector<double>& v) {
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-std::unique_ptr<Simulator<double>> make_simulator(Scene scene, const std::string& backend, int threads,
-                                                  bool adaptive) {
-    if (backend == "serial") return std::make_unique<Simulator<double>>(std::move(scene), nullptr, cpu_operator_factory<double>());
-#ifdef EDGEFEM_PY_HAVE_PARALLEL
-    auto ex = make_executor(parse_backend(backend), threads);
-    if (adaptive) ex = make_adaptive(std::move(ex));
-    return std::make_unique<Simulator<double>>(std::move(scene), ex, cpu_operator_factory<double>({ex}));
-#else
-    (void)threads;
-    (void)adaptive;
-    throw InvalidArgument("backend '" + backend + "': this build has no parallel module (use 'serial')");
-#endif
+// The run options from the keyword arguments (the same names and defaults
+// as RunOptions, the CLI and the C API).
+RunOptions run_options(const std::string& backend, int threads, const std::string& variant, const std::string& schedule,
+                       bool adaptive, const std::string& ordering, const std::string& layout) {
+    RunOptions run;
+    run.backend = backend;
+    run.threads = threads;
+    run.variant = variant;
+    run.schedule = schedule;
+    run.adaptive = adaptive;
+    run.ordering = ordering;
+    run.layout = layout;
+    validate(run);
+    return run;
 }
 
 }  // namespace
@@ -144,11 +142,7 @@ std::unique_ptr<Simulator<double>> make_simulator(Scene scene, const std::string
 PYBIND11_MODULE(edgefem, m) {
     m.doc() = "edgefem: edge-based StVK tetrahedral FEM (meshes, scenes, simulator, kernels).";
     m.attr("__version__") = EDGEFEM_VERSION;
-#ifdef EDGEFEM_PY_HAVE_PARALLEL
-    m.attr("has_parallel") = true;
-#else
-    m.attr("has_parallel") = false;
-#endif
+    m.attr("has_parallel") = true;  // the CPU back-end's threads (always built)
 
     // Exceptions: edgefem.Error and its subclasses, with the C++ message.
     static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
@@ -360,7 +354,7 @@ PYBIND11_MODULE(edgefem, m) {
         .def_readonly("residual", &StaticResult::residual)
         .def_readonly("converged", &StaticResult::converged);
 
-    using Sim = Simulator<double>;
+    using Sim = OrderedSimulator<double>;
     auto vec_view = [](std::span<double> (Sim::*get)()) {
         return [get](py::object self) {
             Sim& s = self.cast<Sim&>();
@@ -377,11 +371,20 @@ PYBIND11_MODULE(edgefem, m) {
     py::class_<Sim>(m, "Simulator",
                     "Steps a Scene (double precision). displacement, velocity and external_forces are (#V, 3) "
                     "numpy views of the simulator's own state: writing into them changes the simulation.")
-        .def(py::init(&make_simulator), py::arg("scene"), py::arg("backend") = "serial", py::arg("threads") = 0,
-             py::arg("adaptive") = true,
-             "backend: 'serial', or 'omp'/'tbb'/'pool' when edgefem.has_parallel (threads <= 0: all). adaptive: the "
-             "loops run serially when their timed first calls were faster so in sum (a small mesh); the "
-             "results are the same either way.")
+        .def(py::init([](const Scene& scene, const std::string& backend, int threads, const std::string& variant,
+                         const std::string& schedule, bool adaptive, const std::string& ordering,
+                         const std::string& layout) {
+                 return make_simulator<double>(scene,
+                                               run_options(backend, threads, variant, schedule, adaptive, ordering, layout));
+             }),
+             py::arg("scene"), py::arg("backend") = RunOptions{}.backend, py::arg("threads") = RunOptions{}.threads,
+             py::arg("variant") = RunOptions{}.variant, py::arg("schedule") = RunOptions{}.schedule,
+             py::arg("adaptive") = RunOptions{}.adaptive, py::arg("ordering") = RunOptions{}.ordering,
+             py::arg("layout") = RunOptions{}.layout,
+             "The run options, with the CLI's names and defaults: backend 'auto' (every core), 'serial', 'omp', "
+             "'tbb', 'pool' or 'reference'; threads (0: all); variant; schedule; adaptive (loops run serially "
+             "where that was faster in sum; same results); ordering (the internal vertex numbering: 'rcm', "
+             "'input', ...; the views stay in the mesh's numbering); layout ('tet-local' or 'tsep-list').")
         .def("step", &Sim::step, py::return_value_policy::copy, py::call_guard<py::gil_scoped_release>(),
              "Advances by scene.dt; raises SimulationError on failure.")
         .def(
@@ -422,11 +425,18 @@ PYBIND11_MODULE(edgefem, m) {
     py::class_<ElasticModel>(m, "ElasticModel",
                              "The elastic kernels on a mesh: energy, forces f = dW/du, and K x, for displacements "
                              "u = x - X of shape (#V, 3).")
-        .def(py::init([](const Mesh& mesh, const Material& material, ModelKind model, Method method) {
-                 return std::make_unique<ElasticModel>(mesh, Materials(material), model, method);
+        .def(py::init([](const Mesh& mesh, const Material& material, ModelKind model, Method method,
+                         const std::string& backend, int threads, const std::string& variant, const std::string& layout) {
+                 return std::make_unique<ElasticModel>(
+                     mesh, Materials(material), model, method,
+                     run_options(backend, threads, variant, RunOptions{}.schedule, false, "input", layout));
              }),
              py::arg("mesh"), py::arg("material") = Material{}, py::arg("model") = ModelKind::FE,
-             py::arg("method") = Method::Edge)
+             py::arg("method") = Method::Edge, py::arg("backend") = RunOptions{}.backend,
+             py::arg("threads") = RunOptions{}.threads, py::arg("variant") = RunOptions{}.variant,
+             py::arg("layout") = RunOptions{}.layout,
+             "The kernels on the mesh as numbered (no ordering), with the run options' back-end, threads, "
+             "variant and layout (their defaults as Simulator's).")
         .def_property_readonly("num_vertices", [](const ElasticModel& em) { return em.mesh.num_vertices(); })
         .def(
             "energy", [](ElasticModel& em, const InArray& u) {
@@ -493,8 +503,15 @@ PYBIND11_MODULE(edgefem, m) {
     // ---- benchmarks ----
     m.def(
         "bench_forces",
-        [](const Mesh& mesh, double seconds, ModelKind model, Method method, const Material& material) {
-            ElasticModel em(mesh, Materials(material), model, method);
+        [](const Mesh& mesh, double seconds, ModelKind model, Method method, const Material& material,
+           const std::string& backend, int threads) {
+            RunOptions run;
+            run.backend = backend;
+            run.threads = threads;
+            run.adaptive = false;  // times the back-end it is given
+            run.ordering = "input";
+            validate(run);
+            ElasticModel em(mesh, Materials(material), model, method, run);
             const std::vector<double> u = deformation_displacement(em.mesh, Deformation::Twist);
             std::vector<double> f(u.size());
             std::vector<double> ns;
@@ -511,7 +528,8 @@ PYBIND11_MODULE(edgefem, m) {
             return r;
         },
         py::arg("mesh"), py::arg("seconds") = 0.5, py::arg("model") = ModelKind::FE, py::arg("method") = Method::Edge,
-        py::arg("material") = Material{},
+        py::arg("material") = Material{}, py::arg("backend") = RunOptions{}.backend,
+        py::arg("threads") = RunOptions{}.threads,
         "Times the force kernel on the twist configuration (as `edgefem bench --kernel force`).");
     m.def(
         "bench_step",

@@ -233,3 +233,35 @@ def test_threads_adaptive_or_not_give_the_same_steps():
     assert (runs[("omp", True)] == runs[("omp", False)]).all()
     assert (runs[("tbb", True)] == runs[("omp", False)]).all()
     assert (runs[("pool", False)] == runs[("omp", False)]).all()
+
+
+def test_run_options_defaults_orderings_and_back_ends_agree():
+    # The defaults (every core, rcm), the input numbering, the reference
+    # back-end and the serial loops in another numbering: the same motion,
+    # with the views and the scene in the mesh's own numbering throughout.
+    scene = clamped_box_scene(6, 3, 2)
+    runs = {}
+    for key, kw in [("default", {}), ("input", dict(ordering="input")), ("reference", dict(backend="reference")),
+                    ("serial-morton", dict(backend="serial", ordering="morton"))]:
+        sim = edgefem.Simulator(scene, **kw)
+        sim.external_forces[-1, 2] = -0.02  # written into the view: takes effect at the next step
+        sim.run(10)
+        runs[key] = sim.displacement.copy()
+        assert np.array_equal(sim.scene.mesh.X, scene.mesh.X)
+        assert sim.positions() == pytest.approx(scene.mesh.X + runs[key], abs=1e-15)
+    ref = runs["reference"]
+    assert np.abs(ref[-1]).max() > 1e-6
+    for key, u in runs.items():
+        assert np.abs(u - ref).max() <= 1e-9 * np.abs(ref).max(), key
+
+
+@pytest.mark.parametrize("kw,name", [(dict(backend="gpu"), "backend"), (dict(ordering="zigzag"), "ordering"),
+                                     (dict(variant="scatter"), "variant"), (dict(threads=-1), "threads"),
+                                     (dict(schedule="guided"), "schedule"), (dict(layout="soa"), "layout"),
+                                     (dict(backend="reference", variant="owner"), "variant")])
+def test_bad_run_options_name_themselves(kw, name):
+    with pytest.raises(edgefem.InvalidArgument, match=name):
+        edgefem.Simulator(clamped_box_scene(2, 2, 2), **kw)
+    if name in ("backend", "threads", "variant") and "ordering" not in kw:
+        with pytest.raises(edgefem.InvalidArgument, match=name):
+            edgefem.ElasticModel(small_box(), **{k: v for k, v in kw.items() if k in ("backend", "threads", "variant")})

@@ -181,8 +181,61 @@ int main(void) {
     CHECK(pushed_uz > free_end_uz);
     CHECK_OK(edgefem_sim_clear_external_forces(sim));
 
+    /* ---- run options: the reference back-end, the CPU back-end's serial
+     * loops in the input numbering and the defaults (every core, rcm) give
+     * the same trajectory (different summation orders: within 1e-9) ---- */
+    {
+        const char* backends[3] = {"reference", "serial", NULL};
+        const char* orderings[3] = {NULL, "input", NULL};
+        double* ur[3];
+        for (int c = 0; c < 3; ++c) {
+            edgefem_run_options run;
+            edgefem_run_options_default(&run);
+            CHECK(run.threads == 0 && run.adaptive == 1 && run.backend == NULL);
+            run.backend = backends[c];
+            run.ordering = orderings[c];
+            edgefem_sim* s = NULL;
+            CHECK_OK(edgefem_sim_create_with(scene, c == 2 ? NULL : &run, &s));
+            ur[c] = calloc(n3, sizeof(double));
+            if (!s) continue;
+            for (int k = 0; k < 20; ++k) CHECK_OK(edgefem_sim_step(s, NULL));
+            CHECK_OK(edgefem_sim_get_displacement(s, ur[c], n3));
+            edgefem_sim_destroy(s);
+        }
+        double umax = 0, d1 = 0, d2 = 0;
+        for (size_t i = 0; i < n3; ++i) {
+            umax = fmax(umax, fabs(ur[0][i]));
+            d1 = fmax(d1, fabs(ur[1][i] - ur[0][i]));
+            d2 = fmax(d2, fabs(ur[2][i] - ur[0][i]));
+        }
+        printf("  run options: |u| %.3g, serial/input and default against reference: %.3g, %.3g\n", umax, d1, d2);
+        CHECK(umax > 1e-5 && d1 <= 1e-9 * umax && d2 <= 1e-9 * umax);
+        for (int c = 0; c < 3; ++c) free(ur[c]);
+    }
+
     /* ---- error paths ---- */
     printf("error paths:\n");
+    {
+        edgefem_run_options run;
+        edgefem_run_options_default(&run);
+        edgefem_sim* s = (edgefem_sim*)0x1;
+        run.backend = "cuda9";
+        expect_error(edgefem_sim_create_with(scene, &run, &s), EDGEFEM_ERROR_INVALID_ARGUMENT, "backend",
+                     "unknown backend");
+        CHECK(s == NULL);
+        edgefem_run_options_default(&run);
+        run.ordering = "zigzag";
+        expect_error(edgefem_sim_create_with(scene, &run, &s), EDGEFEM_ERROR_INVALID_ARGUMENT, "ordering",
+                     "unknown ordering");
+        edgefem_run_options_default(&run);
+        run.adaptive = 2;
+        expect_error(edgefem_sim_create_with(scene, &run, &s), EDGEFEM_ERROR_INVALID_ARGUMENT, "adaptive",
+                     "adaptive neither 0 nor 1");
+        edgefem_run_options_default(&run);
+        run.threads = -3;
+        expect_error(edgefem_sim_create_with(scene, &run, &s), EDGEFEM_ERROR_INVALID_ARGUMENT, "threads",
+                     "negative threads");
+    }
     edgefem_scene* bad = (edgefem_scene*)0x1;
     X[3 * 7 + 1] = NAN;
     expect_error(edgefem_scene_create_from_arrays(X, nv, T, nt, &bad), EDGEFEM_ERROR_MESH, NULL, "NaN coordinate");

@@ -160,9 +160,39 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_cg(edgefem_scene* scene, doubl
 
 /* ---- Simulations ------------------------------------------------------- */
 
-/** Validates the scene and builds a simulation at rest (u = 0, v = 0). The
- *  scene is copied: later changes to it do not affect the simulation. */
+/** How and where a simulation runs: the same options, with the same
+ *  defaults, as the edgefem program's and the Python module's. A NULL string
+ *  takes the default. */
+typedef struct edgefem_run_options {
+    /** "auto" (every core: the CPU back-end on its thread pool, adaptive),
+     *  "serial", "omp", "tbb", "pool" or "reference" (plain loops; slow). */
+    const char* backend;
+    /** Threads of auto/omp/tbb/pool; 0: every hardware thread. */
+    int32_t threads;
+    /** "auto", "colour", "gather", "atomic", "private" or "owner". */
+    const char* variant;
+    /** "dynamic" or "static" (never changes a result). */
+    const char* schedule;
+    /** 1: loops run serially where that measured faster (same results); 0: on the threads. */
+    int32_t adaptive;
+    /** The internal vertex numbering: "rcm", "input", "random", "morton", "nd" or "metis"
+     *  (every array in and out stays in the scene's numbering). */
+    const char* ordering;
+    /** "tet-local" or "tsep-list". */
+    const char* layout;
+} edgefem_run_options;
+
+/** The defaults (backend "auto", every thread, adaptive, "rcm"). */
+EDGEFEM_C_EXPORT void edgefem_run_options_default(edgefem_run_options* out);
+
+/** Validates the scene and builds a simulation at rest (u = 0, v = 0) with
+ *  the default run options. The scene is copied: later changes to it do not
+ *  affect the simulation. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_sim_create(const edgefem_scene* scene, edgefem_sim** out);
+/** The same with run options (NULL: the defaults); an unknown value is
+ *  EDGEFEM_ERROR_INVALID_ARGUMENT with a message naming it. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_create_with(const edgefem_scene* scene, const edgefem_run_options* run,
+                                                        edgefem_sim** out);
 /** Frees a simulation (NULL is ignored). */
 EDGEFEM_C_EXPORT void edgefem_sim_destroy(edgefem_sim* sim);
 

@@ -13,16 +13,16 @@
 
 namespace edgefem {
 
-enum class Backend { Serial, OpenMP, TBB, Pool };
+enum class ExecutorKind { Serial, OpenMP, TBB, Pool };
 
 // How chunks are handed to threads. Results never depend on it (chunks are
 // fixed by the caller); it only changes load balance and overhead.
 enum class Schedule { Static, Dynamic };
 
 // "serial" | "omp" (or "openmp") | "tbb" | "pool"; throws InvalidArgument otherwise.
-Backend parse_backend(std::string_view name);
+ExecutorKind parse_executor_kind(std::string_view name);
 // "serial", "omp", "tbb", "pool".
-const char* to_string(Backend b);
+const char* to_string(ExecutorKind b);
 Schedule parse_schedule(std::string_view name);  // "static" | "dynamic"
 const char* to_string(Schedule s);
 
@@ -134,7 +134,7 @@ private:
 };
 
 // Serial ignores `threads`.
-std::shared_ptr<const Executor> make_executor(Backend backend, int threads = 0,
+std::shared_ptr<const Executor> make_executor(ExecutorKind backend, int threads = 0,
                                               Schedule schedule = Schedule::Dynamic);
 
 // Number of hardware threads available to this process.

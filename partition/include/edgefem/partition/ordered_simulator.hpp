@@ -1,9 +1,13 @@
 // A Simulator that runs on a renumbered copy of the scene (for memory
 // locality) while the application keeps its own vertex numbering: every
-// vertex array in and out is in the user's numbering (copied through the
-// permutation), and so are the vertices that errors name. The core
-// Simulator's zero-copy views are available through internal(), in the
-// internal numbering.
+// vertex array in and out is in the user's numbering, and so are the
+// vertices that errors name. The views (displacement() ...) are the
+// simulator's own user-numbered copies of its state, synchronised with the
+// renumbered state around every step(), solve_static() and energies():
+// written between calls, they take effect at the next call, as the core
+// Simulator's views do. With Ordering::Input (the identity) they are the core
+// Simulator's own state and nothing is copied. The core Simulator is
+// available through internal(), in the internal numbering.
 #pragma once
 
 #include <span>
@@ -28,8 +32,20 @@ public:
     // and the message's "vertex N").
     const StepStats& step();
     StaticResult solve_static();
-    Energies energies() { return sim_.energies(); }
+    Energies energies();
     double time() const { return sim_.time(); }
+    long step_index() const { return sim_.step_index(); }
+    const StepStats& last_stats() const { return sim_.last_stats(); }
+    index_t num_vertices() const { return sim_.num_vertices(); }
+    // The scene as given (the user's numbering).
+    const Scene& scene() const { return user_scene_; }
+
+    // Views of the state in the user's numbering (3 #V; lumped_mass #V).
+    std::span<S> displacement() { return view(u_, &Simulator<S>::displacement); }
+    std::span<S> velocity() { return view(v_, &Simulator<S>::velocity); }
+    std::span<S> external_forces() { return view(fext_, &Simulator<S>::external_forces); }
+    std::span<const S> forces() const { return identity() ? sim_.forces() : std::span<const S>(f_); }
+    std::span<const double> lumped_mass() const { return identity() ? sim_.lumped_mass() : std::span<const double>(mass_); }
 
     // 3 #V values, user numbering; another length throws InvalidArgument.
     void get_displacement(std::span<double> out) const;
@@ -41,11 +57,23 @@ public:
     std::vector<double> positions() const;
 
     Simulator<S>& internal() { return sim_; }
+    // Empty for the identity.
     const std::vector<index_t>& new_of_old() const { return new_of_old_; }
 
 private:
+    bool identity() const { return new_of_old_.empty(); }
+    std::span<S> view(std::vector<S>& mirror, std::span<S> (Simulator<S>::*get)()) {
+        return identity() ? (sim_.*get)() : std::span<S>(mirror);
+    }
+    // The user's views into the internal state (push) and back (pull).
+    void push();
+    void pull();
+
+    Scene user_scene_;
     std::vector<index_t> new_of_old_;
     Simulator<S> sim_;
+    std::vector<S> u_, v_, fext_, f_;  // the user-numbered views (empty for the identity)
+    std::vector<double> mass_;
 };
 
 extern template class OrderedSimulator<double>;

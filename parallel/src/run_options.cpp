@@ -1,0 +1,89 @@
+#include "edgefem/parallel/run_options.hpp"
+
+#include <algorithm>
+#include <initializer_list>
+
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/reference_operator.hpp"
+#include "edgefem/parallel/adaptive_executor.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
+#include "edgefem/parallel/executors.hpp"
+
+namespace edgefem {
+
+namespace {
+
+void require_one_of(const std::string& option, const std::string& value, std::initializer_list<const char*> accepted) {
+    for (const char* a : accepted)
+        if (value == a) return;
+    std::string list;
+    for (const char* a : accepted) list += std::string(list.empty() ? "" : ", ") + a;
+    throw InvalidArgument("run option " + option + ": unknown value '" + value + "' (expected " + list + ")");
+}
+
+bool uses_executor(const RunOptions& run) {
+    return run.backend != "reference" && !(run.backend == "serial" && run.variant == "auto");
+}
+
+}  // namespace
+
+void validate(const RunOptions& run) {
+    require_one_of("backend", run.backend, {"auto", "reference", "serial", "omp", "tbb", "pool"});
+    if (run.threads < 0 || run.threads > kMaxThreads)
+        throw InvalidArgument("run option threads: " + std::to_string(run.threads) + " is outside 0.." +
+                              std::to_string(kMaxThreads) + " (0: every hardware thread)");
+    require_one_of("variant", run.variant, {"auto", "colour", "color", "gather", "atomic", "private", "owner"});
+    require_one_of("schedule", run.schedule, {"static", "dynamic"});
+    require_one_of("ordering", run.ordering, {"input", "random", "rcm", "morton", "nd", "metis"});
+    require_one_of("layout", run.layout, {"tet-local", "tsep-list"});
+    if (run.backend == "reference" && run.variant != "auto")
+        throw InvalidArgument("run option variant: '" + run.variant +
+                              "' applies to the CPU back-end; the reference back-end has none");
+}
+
+std::shared_ptr<const Executor> make_run_executor(const RunOptions& run) {
+    validate(run);
+    if (!uses_executor(run)) return nullptr;
+    const int threads = run.threads > 0 ? run.threads : hardware_threads();
+    ExecutorKind kind = ExecutorKind::Pool;
+    if (run.backend == "serial" || (run.backend == "auto" && threads == 1))
+        kind = ExecutorKind::Serial;
+    else if (run.backend != "auto")
+        kind = parse_executor_kind(run.backend);
+    if (run.backend == "auto" && threads == 1 && run.variant == "auto") return nullptr;  // the serial loops
+    auto ex = make_executor(kind, kind == ExecutorKind::Serial ? 1 : threads, parse_schedule(run.schedule));
+    return run.adaptive && ex->threads() > 1 ? make_adaptive(std::move(ex)) : ex;
+}
+
+template <class S>
+OperatorFactory<S> make_run_factory(const RunOptions& run, std::shared_ptr<const Executor> executor) {
+    validate(run);
+    if (run.backend == "reference")
+        return [](const Mesh& mesh, const Materials& materials, ModelKind model, Method method) {
+            return make_reference_operator<S>(mesh, materials, model, method);
+        };
+    return cpu_operator_factory<S>({std::move(executor), parse_variant(run.variant), parse_stiffness_layout(run.layout)});
+}
+
+template <class S>
+std::unique_ptr<OrderedSimulator<S>> make_simulator(const Scene& scene, const RunOptions& run) {
+    auto ex = make_run_executor(run);
+    auto factory = make_run_factory<S>(run, ex);
+    return std::make_unique<OrderedSimulator<S>>(scene, parse_ordering(run.ordering), std::move(ex), std::move(factory));
+}
+
+std::string describe(const RunOptions& run, const Executor* executor) {
+    if (run.backend == "reference") return "reference";
+    if (!executor) return "serial";
+    std::string name = executor->name();
+    if (const auto* a = dynamic_cast<const AdaptiveExecutor*>(executor)) name = a->inner().name();
+    return name + " x" + std::to_string(executor->threads()) + ", " + run.variant + ", " + run.schedule +
+           (run.adaptive && executor->threads() > 1 ? ", adaptive" : "");
+}
+
+template OperatorFactory<double> make_run_factory<double>(const RunOptions&, std::shared_ptr<const Executor>);
+template OperatorFactory<float> make_run_factory<float>(const RunOptions&, std::shared_ptr<const Executor>);
+template std::unique_ptr<OrderedSimulator<double>> make_simulator<double>(const Scene&, const RunOptions&);
+template std::unique_ptr<OrderedSimulator<float>> make_simulator<float>(const Scene&, const RunOptions&);
+
+}  // namespace edgefem
