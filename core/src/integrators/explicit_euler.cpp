@@ -16,9 +16,7 @@ public:
         s_.start_forces();
         s_.external(1.0);
         const double damp = 1 + T * s_.scene.rayleigh_alpha;
-        s_.each([&](std::size_t i) {
-            s_.x[i] = (double(s_.v[i]) + T * (s_.h[i] - double(s_.f[i])) / s_.mass[i / 3]) / damp;
-        });
+        s_.kernels.explicit_velocity(s_.x.data(), s_.v.data(), s_.h.data(), s_.f.data(), s_.mass.data(), T, damp, s_.n());
         s_.constrained_velocities(T, s_.time + T, s_.x.data());
         s_.take_velocity(T);
         return std::nullopt;

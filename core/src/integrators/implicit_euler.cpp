@@ -15,27 +15,22 @@ public:
 
     std::optional<double> step(double T) override {
         const Scene& scene = s_.scene;
-        auto& u = s_.u;
-        auto& v = s_.v;
         const std::size_t n = s_.n();
         s_.external(1.0);
-        std::vector<double> u0(n), upred(n);
-        s_.each([&](std::size_t i) {
-            u0[i] = double(u[i]);
-            upred[i] = u0[i] + T * double(v[i]);
-        });
+        BackendVector<double> u0 = s_.template vector<double>(n), upred = s_.template vector<double>(n);
+        s_.kernels.implicit_predict(u0.data(), upred.data(), s_.u.data(), s_.v.data(), T, n);
         if (scene.rayleigh_beta > 0) {
-            if (!op_damp_) op_damp_ = s_.factory(scene.mesh, scene.materials, scene.model, scene.method);
-            std::vector<S> scratch(n);
-            op_damp_->forces(u.data(), scratch.data(), false);
+            if (!op_damp_) op_damp_ = s_.backend->make_operator(scene.mesh, scene.materials, scene.model, scene.method);
+            BackendVector<S> scratch = s_.template vector<S>(n);
+            op_damp_->forces(s_.u.data(), scratch.data(), false);
             op_damp_->build_stiffness(scene.solver.definite_stiffness);
         }
         // Start from the prediction with the constrained dofs at their targets.
         const double s = s_.ramp(s_.time + T);
-        s_.each([&](std::size_t i) { u[i] = S(upred[i]); });
+        s_.kernels.to_state(s_.u.data(), upred.data(), n);
         s_.hold_constraints(s);
-        newton_.solve(T, u0, upred, op_damp_.get());
-        s_.each([&](std::size_t i) { v[i] = S((double(u[i]) - u0[i]) / T); });
+        newton_.solve(T, u0.data(), upred.data(), op_damp_.get());
+        s_.kernels.implicit_velocity(s_.v.data(), s_.u.data(), u0.data(), T, n);
         return newton_.energy();  // Newton's last evaluation was at the new u
     }
 

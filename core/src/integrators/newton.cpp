@@ -6,29 +6,24 @@
 #include <string>
 
 #include "simulator/messages.hpp"
-#include "simulator/reductions.hpp"
 
 namespace edgefem::sim {
 
 template <class S>
-void Newton<S>::solve(double T, const std::vector<double>& u0, const std::vector<double>& upred,
-                      const ElasticOperator<S>* K0) {
+void Newton<S>::solve(double T, const double* u0, const double* upred, const ElasticOperator<S>* K0) {
     const Scene& scene = s_.scene;
-    const Executor& exec = *s_.exec;
+    const VectorKernels<S>& k = s_.kernels;
     const std::size_t n = s_.n();
     StepStats& stats = s_.stats;
-    auto& u = s_.u;
-    auto& x = s_.x;
-    auto& b = s_.b;
-    const auto& f = s_.f;
-    const auto& h = s_.h;
-    const auto& mass = s_.mass;
-    const auto& free_dof = s_.free_dof;
+    S* const u = s_.u.data();
+    double* const x = s_.x.data();
     const bool dynamic = T > 0;
     const double c_m = dynamic ? 1 / (T * T) + scene.rayleigh_alpha / T : 0.0;
     const double c_b = dynamic ? scene.rayleigh_beta / T : 0.0;
     const auto& sv = scene.solver;
-    std::vector<double> R(n), du(n), trial(n), K0d(n), inertia(n);
+    BackendVector<double> R = s_.template vector<double>(n), du = s_.template vector<double>(n),
+                          trial = s_.template vector<double>(n), K0d = s_.template vector<double>(n),
+                          inertia = s_.template vector<double>(n);
 
     // Potential, its magnitude (sum of the terms' sizes: its round-off
     // is ~1e-14 of that) and the residual at the current u (u, f updated).
@@ -37,45 +32,23 @@ void Newton<S>::solve(double T, const std::vector<double>& u0, const std::vector
         W_ = W;
         phi = W;
         mag = std::abs(W);
-        std::vector<double>& d = d_;
-        d.resize(n);
-        s_.each([&](std::size_t i) { d[i] = double(u[i]) - (dynamic ? u0[i] : 0.0); });
-        if (c_b != 0) solve_.system().multiply(*K0, d.data(), K0d.data());
-        // Per block: R and the inertia terms, and the sums of h.u, |h u|,
-        // the kinetic terms and their sizes.
-        const std::array<double, 4> sums = blocked_sums<4>(exec, n, [&](std::size_t lo, std::size_t hi) {
-            std::array<double, 4> acc{};
-            for (std::size_t i = lo; i < hi; ++i) {
-                double r = double(f[i]) - h[i];
-                acc[0] += h[i] * double(u[i]);
-                acc[1] += std::abs(h[i] * double(u[i]));
-                inertia[i] = 0;
-                if (dynamic) {
-                    const double m = mass[i / 3], e = double(u[i]) - upred[i];
-                    inertia[i] = m * e / (T * T) + scene.rayleigh_alpha * m * d[i] / T + c_b * K0d[i];
-                    r += inertia[i];
-                    const double kin = 0.5 * m * e * e / (T * T) +
-                                       0.5 * scene.rayleigh_alpha * m * d[i] * d[i] / T + 0.5 * c_b * d[i] * K0d[i];
-                    acc[2] += kin;
-                    acc[3] += std::abs(kin);
-                }
-                R[i] = free_dof[i] ? r : 0.0;
-            }
-            return acc;
-        });
+        d_.resize(n);
+        k.newton_increment(d_.data(), u, dynamic ? u0 : nullptr, n);
+        if (c_b != 0) solve_.system().multiply(*K0, d_.data(), K0d.data());
+        // R and the inertia terms, and the sums of h.u, |h u|, the kinetic
+        // terms and their sizes.
+        const std::array<double, 4> sums =
+            k.newton_residual({R.data(), inertia.data(), s_.f.data(), u, s_.h.data(), s_.mass.data(), upred,
+                               d_.data(), K0d.data(), s_.free_dof.data(), dynamic, T, scene.rayleigh_alpha, c_b},
+                              n);
         phi += sums[2] - sums[0];
         mag += sums[1] + sums[3];
-        scale = scaled_norm(exec, n, [&](std::size_t i) { return double(f[i]); }) +
-                scaled_norm(exec, n, [&](std::size_t i) { return h[i]; }) +
-                scaled_norm(exec, n, [&](std::size_t i) { return inertia[i]; });
+        scale = k.scaled_norm_state(s_.f.data(), n) + k.scaled_norm(s_.h.data(), n) + k.scaled_norm(inertia.data(), n);
     };
-    auto norm = [&](const std::vector<double>& a) {
-        return scaled_norm(exec, n, [&](std::size_t i) { return a[i]; });
-    };
+    auto norm = [&](const BackendVector<double>& a) { return k.scaled_norm(a.data(), n); };
     // du.R: its sign from the scaled sum (the value may underflow).
     auto slope_of = [&](bool& descent) {
-        const Scaled sl =
-            scaled_dot(exec, n, [&](std::size_t i) { return x[i]; }, [&](std::size_t i) { return R[i]; });
+        const Scaled sl = k.scaled_dot(x, R.data(), n);
         descent = sl.mant < 0;
         return sl.value();
     };
@@ -129,28 +102,25 @@ void Newton<S>::solve(double T, const std::vector<double>& u0, const std::vector
                               -1};
         ++stats.newton_iterations;
         // Solve (c_m M + K + c_b K0) du = -R, du = 0 on constrained dofs.
-        s_.each([&](std::size_t i) {
-            b[i] = -R[i];
-            x[i] = 0;
-        });
+        k.newton_rhs(s_.b.data(), x, R.data(), n);
         const double eta = std::min(1e-2, std::max(1e-12, rn / std::max(scale, 1e-300)));
         solve_.solve(c_m, 1.0, c_b, K0, eta, sv.definite_stiffness);
         bool descent = false, newton_direction = true;
         double slope = slope_of(descent);
         if (!descent || !std::isfinite(slope)) {  // not a descent direction: use the definite K
             if (scene.method == Method::Edge) {
-                s_.each([&](std::size_t i) { x[i] = 0; });
+                k.fill(x, n, 0.0);
                 solve_.solve_once(c_m, 1.0, c_b, K0, eta, true);
                 slope = slope_of(descent);
             }
             if (!descent) {  // last resort: scaled gradient
                 newton_direction = false;
-                s_.each([&](std::size_t i) { x[i] = -R[i] / (mass[i / 3] * std::max(c_m, 1.0)); });
+                k.scaled_gradient(x, R.data(), s_.mass.data(), std::max(c_m, 1.0), n);
                 slope = slope_of(descent);
             }
         }
-        s_.copy_state(du, x);
-        s_.each([&](std::size_t i) { trial[i] = double(u[i]); });
+        k.copy(du.data(), x, n);
+        k.from_state(trial.data(), u, n);
         const bool below_resolution = newton_direction && norm(du) <= 8 * eps * norm(trial);
         if (below_resolution && stalled >= 1) {  // (c)
             stats.newton_round_off = true;
@@ -163,7 +133,7 @@ void Newton<S>::solve(double T, const std::vector<double>& u0, const std::vector
         // descent direction for it too).
         double step_len = 1, phi_new = 0, scale_new = 0, mag_new = 0;
         for (int ls = 0;; ++ls) {
-            s_.each([&](std::size_t i) { u[i] = S(trial[i] + step_len * du[i]); });
+            k.line_search_point(u, trial.data(), du.data(), step_len, n);
             evaluate(phi_new, scale_new, mag_new);
             if (std::isfinite(phi_new)) {
                 const double decrease = -1e-4 * step_len * slope;
@@ -174,7 +144,7 @@ void Newton<S>::solve(double T, const std::vector<double>& u0, const std::vector
                 }
             }
             if (ls == 40) {
-                s_.each([&](std::size_t i) { u[i] = S(trial[i]); });
+                k.to_state(u, trial.data(), n);
                 evaluate(phi, scale, mag);  // back to the iterate (and its f, W)
                 if (at_floor()) return;     // (b)
                 if (below_resolution) {     // (c)

@@ -6,8 +6,6 @@
 // cannot converge.
 #pragma once
 
-#include <vector>
-
 #include "solvers/tangent_solve.hpp"
 
 namespace edgefem::sim {
@@ -15,18 +13,19 @@ namespace edgefem::sim {
 template <class S>
 class Newton {
 public:
-    Newton(SimState<S>& state, TangentSolve<S>& solve) : s_(state), solve_(solve) {}
+    Newton(SimState<S>& state, TangentSolve<S>& solve) : s_(state), solve_(solve), d_(state.template vector<double>(0)) {}
 
-    // u0: u at the step's start, upred = u0 + T v (empty when static). K0:
-    // the damping tangent when scene.rayleigh_beta > 0, else null.
-    void solve(double T, const std::vector<double>& u0, const std::vector<double>& upred, const ElasticOperator<S>* K0);
+    // u0: u at the step's start, upred = u0 + T v (3 #V in the back-end's
+    // memory; null when static). K0: the damping tangent when
+    // scene.rayleigh_beta > 0, else null.
+    void solve(double T, const double* u0, const double* upred, const ElasticOperator<S>* K0);
     // The elastic energy at its last evaluation (the final u).
     double energy() const { return W_; }
 
 private:
     SimState<S>& s_;
     TangentSolve<S>& solve_;
-    std::vector<double> d_;  // u - u0 in the residual
+    BackendVector<double> d_;  // u - u0 in the residual
     double W_ = 0;
 };
 

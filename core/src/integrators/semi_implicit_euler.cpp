@@ -21,10 +21,9 @@ public:
         s_.start_forces();
         s_.external(1.0);
         const double c_m = 1 + T * scene.rayleigh_alpha, c_k = T * scene.rayleigh_beta + T * T;
-        s_.each([&](std::size_t i) {
-            s_.b[i] = s_.mass[i / 3] * double(s_.v[i]) + T * (s_.h[i] - double(s_.f[i]));
-            s_.x[i] = double(s_.v[i]);  // warm start
-        });
+        // x = v: the warm start.
+        s_.kernels.semi_implicit_rhs(s_.b.data(), s_.x.data(), s_.v.data(), s_.h.data(), s_.f.data(), s_.mass.data(), T,
+                                     s_.n());
         s_.constrained_velocities(T, s_.time + T, s_.x.data());
         // Reuse K while the interval allows and the step size is the one it
         // was built for (a halved step changes the system matrix).

@@ -8,30 +8,28 @@ namespace edgefem::sim {
 
 template <class S>
 StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
-    auto& u = s.u;
-    s.each([&](std::size_t i) { s.v[i] = S(0); });
+    s.kernels.fill_state(s.v.data(), s.n(), S(0));
     if (s.con_vertex.empty())
         throw InvalidArgument("static equilibrium needs fixed or prescribed vertices (else it is singular)");
     s.stats = StepStats{};
     StaticResult result;
     Newton<S> newton(s, solve);
-    const std::vector<double> none;
     // The increment halves on a failure, at most 12 times over the whole
     // solve. (A budget of 12 per load step, with increments that never
     // grow back, was tried: past a buckling point it ran for minutes on
     // a 96-tet bar, thousands of tiny increments each failing anew.)
     double done = 0, inc = 1.0 / s.scene.solver.load_steps;
     int halvings = 0;
-    std::vector<S> u_save;
+    BackendVector<S> u_save = s.template vector<S>(0);
     while (done < 1 - 1e-15) {
         const double load = std::min(1.0, done + inc);
-        s.copy_state(u_save, u);
+        s.copy_state(u_save, s.u);
         s.external(load);
         s.hold_constraints(load);
         try {
-            newton.solve(0.0, none, none, nullptr);
+            newton.solve(0.0, nullptr, nullptr, nullptr);
         } catch (const StepFailure& failure) {
-            s.copy_state(u, u_save);
+            s.copy_state(s.u, u_save);
             if (++halvings > 12)
                 throw SimulationError("static solve: load fraction " + fmt_load(done) + " -> " + fmt_load(load) + ": " +
                                           failure.message + " even with load increment " + sci(inc) +
@@ -50,7 +48,7 @@ StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
     result.newton_iterations = s.stats.newton_iterations;
     result.residual = s.stats.residual;
     result.converged = true;
-    if (s.scene.count_inverted_tets) s.stats.inverted_tets = s.op->inverted_tets(u.data());
+    if (s.scene.count_inverted_tets) s.stats.inverted_tets = s.op->inverted_tets(s.u.data());
     s.check_finite(s.step);
     return result;
 }

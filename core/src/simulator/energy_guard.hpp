@@ -6,7 +6,7 @@
 // a StepFailure.
 #pragma once
 
-#include <vector>
+#include <cmath>
 
 #include "simulator/state.hpp"
 
@@ -24,7 +24,7 @@ struct EnergySample {
 template <class S>
 class EnergyGuard {
 public:
-    explicit EnergyGuard(SimState<S>& state) : s_(state) {}
+    explicit EnergyGuard(SimState<S>& state) : s_(state), u_evaluated_(state.template vector<S>(0)) {}
     bool enabled() const { return s_.scene.solver.max_energy_growth > 0; }
 
     // The state at the start of a step. The elastic energy comes from the
@@ -47,7 +47,7 @@ private:
     EnergySample sample(double W) const;
 
     SimState<S>& s_;
-    std::vector<S> u_evaluated_;  // the u that f, the operator's state and W_evaluated_ belong to
+    BackendVector<S> u_evaluated_;  // the u that f, the operator's state and W_evaluated_ belong to
     double W_evaluated_ = 0;
     bool evaluated_valid_ = false;
     double energy_excess_ = 0;  // energy gained net of work since its lowest level (>= 0)

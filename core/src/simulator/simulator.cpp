@@ -1,8 +1,10 @@
-// The Simulator: the state (state.hpp), the scene's integrator
-// (integrators/), its linear solver (solvers/) and the step control with
-// the energy guard, put together; the public members read and write the
-// state.
+// The Simulator: the state (state.hpp) on its back-end, the scene's
+// integrator (integrators/), its linear solver (solvers/) and the step
+// control with the energy guard, put together; the public members read and
+// write the state.
 #include "edgefem/core/simulator.hpp"
+
+#include <utility>
 
 #include "integrators/static_solve.hpp"
 #include "integrators/time_integrator.hpp"
@@ -17,8 +19,8 @@ struct Simulator<S>::Impl {
     std::unique_ptr<sim::TimeIntegrator<S>> integrator;
     sim::StepControl<S> control;
 
-    Impl(Scene scene, std::shared_ptr<const Executor> executor, OperatorFactory<S> factory)
-        : state(std::move(scene), std::move(executor), std::move(factory)),
+    Impl(Scene scene, std::shared_ptr<const ComputeBackend<S>> backend)
+        : state(std::move(scene), std::move(backend)),
           solve(state),
           integrator(sim::make_time_integrator(state, solve)),
           control(state, *integrator) {
@@ -29,10 +31,12 @@ struct Simulator<S>::Impl {
         const auto& s = state;
         Energies e;
         e.elastic = s.op->energy(s.u.data());
+        std::vector<S> u_copy, v_copy;
+        const std::span<const S> u = s.u.read_host(u_copy), v = s.v.read_host(v_copy);
         for (std::size_t i = 0; i < s.n(); ++i) {
-            const double m = s.mass[i / 3];
-            e.kinetic += 0.5 * m * double(s.v[i]) * double(s.v[i]);
-            e.gravity -= m * s.scene.gravity[i % 3] * (s.scene.mesh.X[i] + double(s.u[i]));
+            const double m = s.mass_host[i / 3];
+            e.kinetic += 0.5 * m * double(v[i]) * double(v[i]);
+            e.gravity -= m * s.scene.gravity[i % 3] * (s.scene.mesh.X[i] + double(u[i]));
         }
         return e;
     }
@@ -40,7 +44,10 @@ struct Simulator<S>::Impl {
 
 template <class S>
 Simulator<S>::Simulator(Scene scene, std::shared_ptr<const Executor> executor, OperatorFactory<S> factory)
-    : impl_(std::make_unique<Impl>(std::move(scene), std::move(executor), std::move(factory))) {}
+    : impl_(std::make_unique<Impl>(std::move(scene), make_cpu_backend<S>(std::move(executor), std::move(factory)))) {}
+template <class S>
+Simulator<S>::Simulator(Scene scene, std::shared_ptr<const ComputeBackend<S>> backend)
+    : impl_(std::make_unique<Impl>(std::move(scene), std::move(backend))) {}
 template <class S>
 Simulator<S>::~Simulator() = default;
 template <class S>
@@ -75,29 +82,31 @@ StaticResult Simulator<S>::solve_static() {
 }
 template <class S>
 std::span<S> Simulator<S>::displacement() {
-    return self().state.u;
+    return self().state.u.host();
 }
 template <class S>
 std::span<S> Simulator<S>::velocity() {
-    return self().state.v;
+    return self().state.v.host();
 }
 template <class S>
 std::span<S> Simulator<S>::external_forces() {
-    return self().state.fext;
+    return self().state.fext.host();
 }
 template <class S>
 std::span<const S> Simulator<S>::forces() const {
-    return self().state.f;
+    return std::as_const(self().state.f).host();
 }
 template <class S>
 std::span<const double> Simulator<S>::lumped_mass() const {
-    return self().state.mass;
+    return self().state.mass_host;
 }
 template <class S>
 std::vector<double> Simulator<S>::positions() const {
     const auto& s = self().state;
+    std::vector<S> u_copy;
+    const std::span<const S> u = s.u.read_host(u_copy);
     std::vector<double> x(s.n());
-    for (std::size_t i = 0; i < x.size(); ++i) x[i] = s.scene.mesh.X[i] + double(s.u[i]);
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = s.scene.mesh.X[i] + double(u[i]);
     return x;
 }
 template <class S>

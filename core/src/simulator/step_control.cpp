@@ -8,10 +8,10 @@ void StepControl<S>::advance(double T, int depth) {
     // whole step's start is kept by step()).
     const bool may_retry = depth < s_.scene.solver.max_step_halvings;
     // Depth 0 restores the step's start, which step() has just saved.
-    std::vector<S> u_save, v_save;
+    BackendVector<S> u_save = s_.template vector<S>(0), v_save = s_.template vector<S>(0);
     if (may_retry && depth > 0) {
-        u_save = s_.u;
-        v_save = s_.v;
+        s_.copy_state(u_save, s_.u);
+        s_.copy_state(v_save, s_.v);
     }
     try {
         s_.forces_current = false;
@@ -31,13 +31,8 @@ void StepControl<S>::advance(double T, int depth) {
     } catch (const StepFailure& failure) {
         s_.forces_current = false;
         if (!may_retry) throw;
-        if (depth == 0) {
-            s_.copy_state(s_.u, step_start_u_);
-            s_.copy_state(s_.v, step_start_v_);
-        } else {
-            s_.u = u_save;
-            s_.v = v_save;
-        }
+        s_.copy_state(s_.u, depth == 0 ? step_start_u_ : u_save);
+        s_.copy_state(s_.v, depth == 0 ? step_start_v_ : v_save);
         ++s_.stats.halvings;
         advance(T / 2, depth + 1);
         advance(T / 2, depth + 1);
@@ -58,8 +53,8 @@ const StepStats& StepControl<S>::step() {
         advance(s_.scene.dt, 0);
     } catch (const StepFailure& failure) {
         s_.time = t_start;
-        s_.u.assign(step_start_u_.begin(), step_start_u_.end());
-        s_.v.assign(step_start_v_.begin(), step_start_v_.end());
+        s_.copy_state(s_.u, step_start_u_);
+        s_.copy_state(s_.v, step_start_v_);
         s_.forces_current = false;
         throw SimulationError(failure.message, s_.step + 1, failure.vertex);
     }

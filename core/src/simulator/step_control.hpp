@@ -4,8 +4,6 @@
 // the state it started from and throws SimulationError.
 #pragma once
 
-#include <vector>
-
 #include "integrators/time_integrator.hpp"
 #include "simulator/energy_guard.hpp"
 
@@ -15,7 +13,8 @@ template <class S>
 class StepControl {
 public:
     StepControl(SimState<S>& state, TimeIntegrator<S>& integrator)
-        : s_(state), integrator_(integrator), guard_(state) {}
+        : s_(state), integrator_(integrator), guard_(state), step_start_u_(state.template vector<S>(0)),
+          step_start_v_(state.template vector<S>(0)) {}
     const StepStats& step();
 
 private:
@@ -24,7 +23,7 @@ private:
     SimState<S>& s_;
     TimeIntegrator<S>& integrator_;
     EnergyGuard<S> guard_;
-    std::vector<S> step_start_u_, step_start_v_;  // the state before the step (restored when it fails)
+    BackendVector<S> step_start_u_, step_start_v_;  // the state before the step (restored when it fails)
 };
 
 extern template class StepControl<double>;

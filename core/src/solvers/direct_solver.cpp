@@ -1,5 +1,6 @@
 // The assembled path: A on the free dofs as an Eigen sparse matrix
-// (sparse_assembly.hpp), factorised by SimplicialLDLT.
+// (sparse_assembly.hpp), factorised by SimplicialLDLT. On the host: b and x
+// through host() (back-ends with host memory).
 #include <Eigen/SparseCholesky>
 #include <cmath>
 #include <utility>
@@ -19,21 +20,24 @@ public:
     bool reusable() const override { return false; }
 
     void setup(LinearSystem<S>& A) override {
-        nf_ = number_free_dofs(s_.free_dof, dof_index_);
+        nf_ = number_free_dofs(s_.free_host, dof_index_);
         std::vector<std::pair<double, const ElasticOperator<S>*>> terms{{A.c_k(), &A.K()}};
         if (A.c_b() != 0) terms.emplace_back(A.c_b(), A.K0());
-        matrix_ = assemble_system(dof_index_, nf_, A.c_m(), s_.mass, terms);
+        matrix_ = assemble_system(dof_index_, nf_, A.c_m(), s_.mass_host, terms);
         ldlt_.compute(matrix_);
     }
 
-    CgResult solve(LinearSystem<S>& A, std::vector<double>& b, std::vector<double>& x, double, int) override {
+    CgResult solve(LinearSystem<S>& A, BackendVector<double>& b_vec, BackendVector<double>& x_vec, double,
+                   int) override {
         CgResult res;
         const std::size_t n = s_.n();
-        const auto& free_dof = s_.free_dof;
+        const std::span<const double> b = b_vec.host();
+        const std::span<double> x = x_vec.host();
+        const auto& free_dof = s_.free_host;
         // rhs = b - A x_constrained
-        std::vector<double> xc(n);
+        BackendVector<double> xc_vec = s_.template vector<double>(n), Ac_vec = s_.template vector<double>(n);
+        const std::span<double> xc = xc_vec.host(), Ac = Ac_vec.host();
         for (std::size_t i = 0; i < n; ++i) xc[i] = free_dof[i] ? 0.0 : x[i];
-        std::vector<double> Ac(n);
         A.apply(xc.data(), Ac.data());
         Eigen::VectorXd rhs(nf_);
         for (std::size_t i = 0; i < n; ++i)

@@ -9,9 +9,9 @@ void LinearSystem<S>::multiply(const ElasticOperator<S>& op, const double* in, d
     } else {
         xs_.resize(s_.n());
         ys_.resize(s_.n());
-        s_.each([&](std::size_t i) { xs_[i] = S(in[i]); });
+        s_.kernels.to_state(xs_.data(), in, s_.n());
         op.multiply(xs_.data(), ys_.data());
-        s_.each([&](std::size_t i) { out[i] = double(ys_[i]); });
+        s_.kernels.from_state(out, ys_.data(), s_.n());
     }
 }
 
@@ -24,25 +24,15 @@ void LinearSystem<S>::products(const double* in, double* out) {
     }
 }
 
-// Mass per dof, scalars by value: vectorises (over mass[i / 3] with c_m,
-// c_k by reference it did not).
 template <class S>
 void LinearSystem<S>::finish(std::size_t lo, std::size_t hi, const double* in, double* out) const {
-    const double c_m = c_m_, c_k = c_k_, c_b = c_b_;
-    const double* __restrict m = s_.mass_dof.data();
-    const double* __restrict xin = in;
-    double* __restrict y = out;
-    for (std::size_t i = lo; i < hi; ++i) y[i] = c_m * m[i] * xin[i] + c_k * y[i];
-    if (c_b != 0) {
-        const double* __restrict a = Ax_.data();
-        for (std::size_t i = lo; i < hi; ++i) y[i] += c_b * a[i];
-    }
+    s_.kernels.system_diagonal_range(lo, hi, c_m_, c_k_, c_b_, s_.mass_dof.data(), in, Ax_.data(), out);
 }
 
 template <class S>
 void LinearSystem<S>::apply(const double* in, double* out) {
     products(in, out);
-    for_blocks(*s_.exec, s_.n(), [&](std::size_t lo, std::size_t hi) { finish(lo, hi, in, out); });
+    s_.kernels.system_diagonal(s_.n(), c_m_, c_k_, c_b_, s_.mass_dof.data(), in, Ax_.data(), out);
 }
 
 template class LinearSystem<double>;

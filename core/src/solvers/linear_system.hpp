@@ -1,20 +1,20 @@
 // The system the implicit steps solve: A = c_m M + c_k K + c_b K0, with M
 // the lumped mass, K the operator's tangent and K0 a second operator's (the
 // tangent frozen at the step's start for Rayleigh damping; none when
-// c_b = 0). Applied in two parts, as conjugate_gradient takes it: the
-// products K x (and K0 x), then per block the mass term and the sum.
+// c_b = 0). Applied in two parts, as the cg kernel takes it: the products
+// K x (and K0 x), then per range the mass term and the sum.
 #pragma once
-
-#include <vector>
 
 #include "simulator/state.hpp"
 
 namespace edgefem::sim {
 
 template <class S>
-class LinearSystem {
+class LinearSystem final : public CgSystem {
 public:
-    explicit LinearSystem(SimState<S>& state) : s_(state) {}
+    explicit LinearSystem(SimState<S>& state)
+        : s_(state), Ax_(state.template vector<double>(0)), xs_(state.template vector<S>(0)),
+          ys_(state.template vector<S>(0)) {}
 
     void set(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0) {
         c_m_ = c_m;
@@ -27,14 +27,13 @@ public:
     double c_b() const { return c_b_; }
     const ElasticOperator<S>& K() const { return *s_.op; }
     const ElasticOperator<S>* K0() const { return K0_; }
-    const SimState<S>& state() const { return s_; }
 
     // y = op x with double vectors (converts for float models).
     void multiply(const ElasticOperator<S>& op, const double* in, double* out);
     // out = K in, and K0 in kept for finish().
-    void products(const double* in, double* out);
+    void products(const double* in, double* out) override;
     // out = c_m M in + c_k out (+ c_b K0 in) on [lo, hi), after products().
-    void finish(std::size_t lo, std::size_t hi, const double* in, double* out) const;
+    void finish(std::size_t lo, std::size_t hi, const double* in, double* out) const override;
     // out = A in.
     void apply(const double* in, double* out);
 
@@ -42,8 +41,8 @@ private:
     SimState<S>& s_;
     double c_m_ = 0, c_k_ = 0, c_b_ = 0;
     const ElasticOperator<S>* K0_ = nullptr;
-    std::vector<double> Ax_;     // K0 x
-    std::vector<S> xs_, ys_;     // float models: the product's vectors in S
+    BackendVector<double> Ax_;  // K0 x
+    BackendVector<S> xs_, ys_;  // float models: the product's vectors in S
 };
 
 extern template class LinearSystem<double>;

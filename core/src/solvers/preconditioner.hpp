@@ -1,8 +1,7 @@
 // A preconditioner for CG on a LinearSystem: set up after K was built,
-// then applied block by block inside CG's passes.
+// then applied range by range inside the cg kernel's passes.
 #pragma once
 
-#include <cstddef>
 #include <memory>
 
 #include "solvers/linear_system.hpp"
@@ -10,13 +9,9 @@
 namespace edgefem::sim {
 
 template <class S>
-class Preconditioner {
+class Preconditioner : public CgPreconditioner {
 public:
-    virtual ~Preconditioner() = default;
     virtual void setup(const LinearSystem<S>& A) = 0;
-    // z = M^-1 r on [lo, hi) from r on [lo, hi) only; lo and hi are
-    // multiples of 3 (whole vertices) or n.
-    virtual void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const = 0;
 };
 
 // Block-Jacobi (block_jacobi.cpp).

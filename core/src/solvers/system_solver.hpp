@@ -4,9 +4,7 @@
 #pragma once
 
 #include <memory>
-#include <vector>
 
-#include "edgefem/core/cg.hpp"
 #include "solvers/linear_system.hpp"
 
 namespace edgefem::sim {
@@ -22,7 +20,7 @@ public:
     virtual void setup(LinearSystem<S>& A) = 0;
     // x holds a warm start; `fixed_iterations` > 0: exactly that many
     // iterations (iterative solvers).
-    virtual CgResult solve(LinearSystem<S>& A, std::vector<double>& b, std::vector<double>& x, double tolerance,
+    virtual CgResult solve(LinearSystem<S>& A, BackendVector<double>& b, BackendVector<double>& x, double tolerance,
                            int fixed_iterations) = 0;
 };
 
