@@ -1,4 +1,5 @@
-// Memory layouts against each other (docs/layouts.md, "Layouts"), double
+// Memory layouts against each other (docs/layouts.md, "Tried and lost";
+// measured: docs/lab/layouts-log.md, "Layouts"), double
 // FE, one thread, twist configuration:
 //   force/<layout>/<ordering>/<mesh>      the force kernel in each storage
 //       layout of layout_kernels.hpp (<aos|soa>-<double|float>-<split|packed>),

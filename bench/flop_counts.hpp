@@ -52,21 +52,24 @@ inline constexpr long kTetFormStiffnessPerLane = 72 + 360 + 6 * (9 + 45 + 9);
 inline constexpr long kEdgeKx = 39;
 inline constexpr long kVertexKx = 3;
 
-// Per-tet kernels: the one-tet form (tet_kernels.hpp), which the counting
-// scalar runs. The batched form that float and double run
-// (tet_batch_kernels.hpp) skips G's lower triangle (24) and F F^T's (15)
-// and scales F a by lambda and mu once per vertex row (36): fewer FLOPs
-// than counted here.
-// tet_deformation: D 9, H = D Dm^-1 45, G 72, tr 2, S 30, F 9, G:G 18, energy 5.
-inline constexpr long kTetDeformation = 190;
-// Of which the energy (G:G 18 + energy 5): dead code when the energy is not used.
-inline constexpr long kTetEnergyOnly = 23;
-// tet_force after the deformation: P = F S 45; 3 rows x (3 x (5 + 1 + 1) + 1).
-inline constexpr long kTetForceTail = 111;
-// tet_stiffness after the deformation: a_0 6, F a and S a 120, F F^T 45,
-// 10 blocks x (aSa 5 + mu aa 6 + 3 rows x (lambda Fa, mu Fa 2 + 3 entries
-// x (3 mul + 2 add) + diagonal 1)).
-inline constexpr long kTetStiffnessTail = 6 + 120 + 45 + 10 * (5 + 6 + 3 * (2 + 3 * 5 + 1));
+// Per-tet kernels (physics/tet_stvk.hpp): the one-tet loops that the
+// counting scalar runs and the 4-lane batches that float and double run
+// call the same formulas, so these counts hold for both (per lane).
+// tet_deformation: D 9, H = D Dm^-1 9 x (3 mul + 2 add) 45, G's upper
+// triangle 6 x (2 add + 3 x (mul + add) + 0.5 x) 48, tr 2, 2 mu and lambda
+// tr 2, S 9 x (mul + add) 18.
+inline constexpr long kTetDeformation = 124;
+// With the energy: G's off-diagonal squares 5, G:G 7, Vol(lambda/2 tr^2 +
+// mu G:G) 5 (tet_force computes it; the stiffness does not ask for it).
+inline constexpr long kTetEnergyOnly = 17;
+// tet_force after the deformation: P = S + H S 9 x (3 mul + 3 add) 54; per
+// row 3 x (P a_i 5 + sum 1) 18, x 3 rows 54; 12 vertex updates.
+inline constexpr long kTetForceTail = 54 + 54 + 12;
+// tet_stiffness after the deformation: F = I + H 9, a_0 6, F a and S a
+// 4 x 3 x 10 = 120, lambda F a and mu F a 24, F F^T's upper triangle 6 x 5 =
+// 30, per block a_i.S a_j 5 and mu a_i.a_j 6 (x 10 blocks), 90 entries x
+// (3 mul + 2 add) and a_i.S a_j on the 30 diagonal entries.
+inline constexpr long kTetStiffnessTail = 9 + 6 + 120 + 24 + 30 + 10 * (5 + 6) + 90 * 5 + 30;
 // tet_kx from stored blocks: 4 x (4 blocks x 3 rows x (3 mul + 3 add)) + 12 updates.
 inline constexpr long kTetKx = 4 * 4 * 3 * 6 + 12;
 
@@ -117,15 +120,15 @@ inline Count edge_kx(const Items& n) {
     return {v, v};
 }
 
-// Per-tet: `with_energy` counts the energy's arithmetic, which the source
-// computes in every tet_deformation call (the counting scalar sees it) but an
-// optimising compiler drops where the energy is unused.
+// Per-tet: the force computes the energy too (`with_energy`: what the
+// source computes and the counting scalar sees; an optimising compiler
+// drops it where the energy is unused); the stiffness never does.
 inline Count tet_force(const Items& n, bool with_energy) {
-    const double v = n.T * (kTetDeformation - (with_energy ? 0 : kTetEnergyOnly) + kTetForceTail);
+    const double v = n.T * (kTetDeformation + (with_energy ? kTetEnergyOnly : 0) + kTetForceTail);
     return {v, v};
 }
-inline Count tet_stiffness(const Items& n, bool with_energy) {
-    const double v = n.T * (kTetDeformation - (with_energy ? 0 : kTetEnergyOnly) + kTetStiffnessTail);
+inline Count tet_stiffness(const Items& n) {
+    const double v = n.T * (kTetDeformation + kTetStiffnessTail);
     return {v, v};
 }
 inline Count tet_kx(const Items& n) { return {n.T * kTetKx, n.T * kTetKx}; }

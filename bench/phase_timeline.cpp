@@ -7,11 +7,11 @@
 // (Executor::for_linked_phases, the default) and with a barrier between
 // phases (the Executor base class's for_linked_phases), and prints each
 // round's medians and their ratio: the two run in one process, paired
-// round by round (docs/parallel.md, Update 7). `step` instead runs
-// semi-implicit steps (bench_step's scene, 20 CG iterations) and prints the
-// wall time per step of every executor call site (the loop body's type):
-// where a step's time goes on N threads. A diagnostic, not a benchmark: the
-// tracer's stamps cost ~20 ns per part.
+// round by round (measured with it: docs/lab/parallel-log.md, Update 7).
+// `step` instead runs semi-implicit steps (bench_step's scene, 20 CG
+// iterations) and prints the wall time per step of every executor call site
+// (the loop body's type): where a step's time goes on N threads. A
+// diagnostic, not a benchmark: the tracer's stamps cost ~20 ns per part.
 //
 //   edgefem_phase_timeline MESH [force|stiffness|kx|step] [--backend pool|omp|tbb|serial]
 //                          [--threads N] [--barriers] [--calls N] [--compare ROUNDS]

@@ -1,5 +1,5 @@
 // `edgefem bench-layouts MESH`: the memory-layout comparison
-// (docs/layouts.md, "Layouts"). One table row per ordering x layout x
+// (docs/layouts.md, "Storage layouts"). One table row per ordering x layout x
 // back-end x threads with the median ns per tet of the force kernel, the
 // stiffness K, K x and a whole semi-implicit step, the bytes of precomputed
 // data per tet and, with --cachegrind, the D1 and last-level data-cache

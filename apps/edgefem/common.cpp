@@ -178,7 +178,7 @@ void print_adaptive(const Executor& executor) {
 void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
     cmd.add_option("--backend", opts.backend,
                    "Where the kernels run: serial (core's loops), omp (OpenMP), tbb (oneTBB) or pool (std::threads "
-                   "that spin between calls: no system call per call; docs/parallel.md, Update 6)")
+                   "that spin between calls: no system call per call; docs/parallel.md, \"Back-ends\")")
         ->check(CLI::IsMember({"serial", "omp", "tbb", "pool"}))
         ->capture_default_str();
     cmd.add_option("--threads", opts.threads, "Threads of the omp/tbb/pool back-end (0: all hardware threads)")
@@ -188,7 +188,7 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
                    "How the omp/tbb/pool back-end hands the kernels' chunks to threads: dynamic (balances uneven "
                    "parts) or static (the same chunks to the same threads at every call, so each thread's "
                    "data stays in its cache). Results are identical; CG's vector passes and the owner K x "
-                   "are always static (docs/parallel.md)")
+                   "are always static (docs/parallel.md, \"Schedules\")")
         ->check(CLI::IsMember({"static", "dynamic"}))
         ->capture_default_str();
     cmd.add_option("--adaptive", opts.adaptive,
@@ -196,7 +196,7 @@ void add_exec_options(CLI::App& cmd, ExecOptions& opts, bool with_variant) {
                    "thread alternately, and all loops then run where they were faster in sum (small meshes, "
                    "where a barrier costs more than the work it splits, go serial; timed again after 2^14 "
                    "calls, then 2^15, ...); off: every loop on the threads. Results are identical "
-                   "(docs/parallel.md, Update 6)")
+                   "(docs/parallel.md, \"The adaptive executor\")")
         ->check(CLI::IsMember({"on", "off"}))
         ->capture_default_str();
     if (with_variant)

@@ -52,7 +52,7 @@ struct alignas(64) Share {
 // chunks on different cores and a different core for a chunk at each call,
 // whose data then crossed between the cores (on a VM whose cores sit 0.4 µs
 // apart: bunny-50k's 2-thread force 0.41 ms against 0.29-0.30 static;
-// docs/parallel.md, Update 6).
+// measured: docs/lab/parallel-log.md, Update 6).
 inline void fill_shares(Share* shares, int t, index_t n) {
     for (int i = 0; i < t; ++i) {
         shares[i].next.store(index_t(std::int64_t(n) * i / t), std::memory_order_relaxed);
@@ -104,8 +104,8 @@ void spin_until(const Done& done) {
 // spun on. libgomp's barrier ends with a futex_wake system call by the last
 // thread to arrive, every time; on a VM with page-table isolation that made
 // each phase boundary cost 1.2-1.7 µs, against 0.08-0.10 for this one
-// (docs/parallel.md, Update 6). A waiter spins, then yields, so that an
-// oversubscribed team still makes progress.
+// (measured: docs/lab/parallel-log.md, Update 6). A waiter spins, then
+// yields, so that an oversubscribed team still makes progress.
 struct alignas(64) PhaseBarrier {
     alignas(64) std::atomic<int> arrived{0};
     alignas(64) std::atomic<int> generation{0};

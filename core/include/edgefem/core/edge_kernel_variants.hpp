@@ -37,9 +37,9 @@ inline void vertex_force_gather(index_t v, const index_t* __restrict incident, i
         const S s = S(g[e]);
         const S* q = &p[3 * std::size_t(e)];
         if (incident_is_v1(incident[k]))
-            for (int r = 0; r < 3; ++r) acc[r] -= q[r] * s;
+            for (int r = 0; r < 3; ++r) acc[r] -= physics::edge_force(q[r], s);
         else
-            for (int r = 0; r < 3; ++r) acc[r] += q[r] * s;
+            for (int r = 0; r < 3; ++r) acc[r] += physics::edge_force(q[r], s);
     }
     for (int r = 0; r < 3; ++r) f[3 * std::size_t(v) + r] = acc[r];
 }
@@ -51,12 +51,10 @@ template <class S>
 inline void tsep_strain_gather(const EdgeModel<S>& m, index_t e, const index_t* __restrict in_e0,
                                const S* __restrict in_L, index_t n, const S* __restrict zeta, double* __restrict g) {
     double ge = g[e];
-    for (index_t k = 0; k < n; ++k) ge += double(in_L[k]) * double(zeta[in_e0[k]]);
+    for (index_t k = 0; k < n; ++k) ge += physics::pair_g(double(in_L[k]), double(zeta[in_e0[k]]));
     double acc = 0;
-    for (index_t P = m.tsep_first[e]; P < m.tsep_first[e + 1]; ++P) {
-        const double L = m.LP[P];
-        acc += L * double(zeta[m.tsep_other[P]]);
-    }
+    for (index_t P = m.tsep_first[e]; P < m.tsep_first[e + 1]; ++P)
+        acc += physics::pair_g(double(m.LP[P]), double(zeta[m.tsep_other[P]]));
     g[e] = ge + acc;
 }
 
@@ -68,8 +66,8 @@ struct StiffnessSource {
     std::uint8_t slot;
 };
 
-// K(e2) += sum over its incoming TSEP contributions of
-// (-1)^(i+j) 2 L(P) p~(E0) p~(E1)^T (transposed where flagged).
+// K(e2) += its incoming TSEP contributions (physics/tsep_stiffness.hpp),
+// in source order.
 template <class S>
 inline void tsep_stiffness_gather(const EdgeModel<S>& m, index_t e2, const StiffnessSource* __restrict in, index_t n,
                                   const S* __restrict p, S* __restrict K) {
@@ -78,23 +76,10 @@ inline void tsep_stiffness_gather(const EdgeModel<S>& m, index_t e2, const Stiff
     for (int i = 0; i < 9; ++i) acc[i] = blk[i];
     for (index_t s = 0; s < n; ++s) {
         const index_t P = in[s].tsep;
-        const int k = in[s].slot & 3;
         const bool transposed = (in[s].slot & 4) != 0;
-        const S* p0 = &p[3 * std::size_t(in[s].e0)];
-        const S* p1 = &p[3 * std::size_t(m.tsep_other[P])];
-        const S c = 2 * m.LP[P];
-        S kp[9];
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) {
-                if (transposed)
-                    kp[3 * j + i] = c * p0[i] * p1[j];
-                else
-                    kp[3 * i + j] = c * p0[i] * p1[j];
-            }
-        if (k == 0 || k == 3)
-            for (int i = 0; i < 9; ++i) acc[i] += kp[i];
-        else
-            for (int i = 0; i < 9; ++i) acc[i] -= kp[i];
+        const S* ends[2] = {&p[3 * std::size_t(in[s].e0)], &p[3 * std::size_t(m.tsep_other[P])]};
+        physics::add_pair_block(physics::slot_coefficient(physics::pair_coefficient(m.LP[P]), in[s].slot & 3),
+                                ends[transposed], ends[!transposed], acc);
     }
     for (int i = 0; i < 9; ++i) blk[i] = acc[i];
 }
@@ -111,9 +96,9 @@ inline void vertex_kx_gather(const EdgeModel<S>& m, index_t v, const index_t* __
         const S* k = &K[9 * std::size_t(e)];
         const S d[3] = {x[3 * a] - x[3 * b], x[3 * a + 1] - x[3 * b + 1], x[3 * a + 2] - x[3 * b + 2]};
         if (incident_is_v1(incident[s]))
-            for (int i = 0; i < 3; ++i) acc[i] += k[i] * d[0] + k[3 + i] * d[1] + k[6 + i] * d[2];
+            for (int i = 0; i < 3; ++i) acc[i] += physics::transpose_times(k[i], k[3 + i], k[6 + i], d[0], d[1], d[2]);
         else
-            for (int i = 0; i < 3; ++i) acc[i] -= k[3 * i] * d[0] + k[3 * i + 1] * d[1] + k[3 * i + 2] * d[2];
+            for (int i = 0; i < 3; ++i) acc[i] -= physics::row_times(k[3 * i], k[3 * i + 1], k[3 * i + 2], d[0], d[1], d[2]);
     }
     for (int i = 0; i < 3; ++i) y[3 * std::size_t(v) + i] = acc[i];
 }
@@ -126,10 +111,9 @@ inline void vertex_diagonal_gather(index_t v, const index_t* __restrict incident
     for (index_t s = 0; s < n; ++s) {
         const S* k = &K[9 * std::size_t(incident_edge(incident[s]))];
         if (incident_is_v1(incident[s]))
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) acc[3 * i + j] -= k[3 * j + i];
+            physics::subtract_block_transposed(k, acc);
         else
-            for (int i = 0; i < 9; ++i) acc[i] -= k[i];
+            physics::subtract_block(k, acc);
     }
     for (int i = 0; i < 9; ++i) D[9 * std::size_t(v) + i] = acc[i];
 }
@@ -146,8 +130,8 @@ inline void tsep_strain_segment_to(const EdgeModel<S>& m, index_t e0, const S* _
     for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
         const index_t e1 = m.tsep_other[P];
         const double L = m.LP[P];
-        acc += L * double(zeta[e1]);
-        add_g(e1, L * z0);
+        acc += physics::pair_g(L, double(zeta[e1]));
+        add_g(e1, physics::pair_g(L, z0));
     }
     add_g(e0, acc);
 }
@@ -157,7 +141,7 @@ inline void edge_force_to(const EdgeModel<S>& m, index_t e, const S* __restrict 
                           Add&& add) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     for (int r = 0; r < 3; ++r) {
-        const S v = p[3 * std::size_t(e) + r] * S(g[e]);
+        const S v = physics::edge_force(p[3 * std::size_t(e) + r], S(g[e]));
         add(3 * std::size_t(a) + r, v);
         add(3 * std::size_t(b) + r, -v);
     }
@@ -169,23 +153,15 @@ inline void tsep_stiffness_segment_to(const EdgeModel<S>& m, index_t e0, const S
     const S* p0 = &p[3 * std::size_t(e0)];
     const index_t sink = m.num_edges();
     for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
-        const S* p1 = &p[3 * std::size_t(m.tsep_other[P])];
-        const S c = 2 * m.LP[P];
-        S kp[18];
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) {
-                kp[3 * i + j] = c * p0[i] * p1[j];
-                kp[9 + 3 * j + i] = kp[3 * i + j];
-            }
+        const S* ends[2] = {p0, &p[3 * std::size_t(m.tsep_other[P])]};
+        const S c = physics::pair_coefficient(m.LP[P]);
         for (int k = 0; k < 4; ++k) {
             const index_t t = m.target[P][k];
             if ((t >> 1) >= sink) continue;
-            const S* src = kp + 9 * (t & 1);
+            S kp[9] = {};
+            physics::add_pair_block(physics::slot_coefficient(c, k), ends[t & 1], ends[(t & 1) ^ 1], kp);
             const std::size_t blk = 9 * std::size_t(t >> 1);
-            if (k == 0 || k == 3)
-                for (int i = 0; i < 9; ++i) add(blk + i, src[i]);
-            else
-                for (int i = 0; i < 9; ++i) add(blk + i, -src[i]);
+            for (int i = 0; i < 9; ++i) add(blk + i, kp[i]);
         }
     }
 }
@@ -196,20 +172,21 @@ inline void edge_kx_to(const EdgeModel<S>& m, index_t e, const S* __restrict K, 
     const S* k = &K[9 * std::size_t(e)];
     const S d[3] = {x[3 * a] - x[3 * b], x[3 * a + 1] - x[3 * b + 1], x[3 * a + 2] - x[3 * b + 2]};
     for (int i = 0; i < 3; ++i) {
-        add(3 * std::size_t(a) + i, -(k[3 * i] * d[0] + k[3 * i + 1] * d[1] + k[3 * i + 2] * d[2]));
-        add(3 * std::size_t(b) + i, k[i] * d[0] + k[3 + i] * d[1] + k[6 + i] * d[2]);
+        add(3 * std::size_t(a) + i, -physics::row_times(k[3 * i], k[3 * i + 1], k[3 * i + 2], d[0], d[1], d[2]));
+        add(3 * std::size_t(b) + i, physics::transpose_times(k[i], k[3 + i], k[6 + i], d[0], d[1], d[2]));
     }
 }
 
 template <class S, class Add>
 inline void edge_diagonal_to(const EdgeModel<S>& m, index_t e, const S* __restrict K, Add&& add) {
-    const index_t a = m.edge[e][0], b = m.edge[e][1];
     const S* k = &K[9 * std::size_t(e)];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            add(9 * std::size_t(a) + 3 * i + j, -k[3 * i + j]);
-            add(9 * std::size_t(b) + 3 * i + j, -k[3 * j + i]);
-        }
+    S d0[9] = {}, d1[9] = {};
+    physics::subtract_block(k, d0);
+    physics::subtract_block_transposed(k, d1);
+    for (int q = 0; q < 9; ++q) {
+        add(9 * std::size_t(m.edge[e][0]) + q, d0[q]);
+        add(9 * std::size_t(m.edge[e][1]) + q, d1[q]);
+    }
 }
 
 }  // namespace edgefem::kernel

@@ -16,6 +16,12 @@
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/kernel_inline.hpp"
 #include "edgefem/core/xyz4.hpp"
+#include "edgefem/physics/edge_blocks.hpp"
+#include "edgefem/physics/edge_force.hpp"
+#include "edgefem/physics/edge_g.hpp"
+#include "edgefem/physics/edge_stiffness.hpp"
+#include "edgefem/physics/edge_strain.hpp"
+#include "edgefem/physics/tsep_stiffness.hpp"
 
 namespace edgefem {
 
@@ -66,15 +72,15 @@ EDGEFEM_KERNEL void edge_strain(const EdgeModel<S>& m, const S* __restrict u, in
                         S* __restrict zeta, double* __restrict g, Slot slot = {}) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     const S* r = &m.rest[3 * std::size_t(e)];
-    const S d0 = u[3 * a] - u[3 * b], d1 = u[3 * a + 1] - u[3 * b + 1], d2 = u[3 * a + 2] - u[3 * b + 2];
-    const S q0 = r[0] + d0, q1 = r[1] + d1, q2 = r[2] + d2;
-    const S z = d0 * (r[0] + q0) + d1 * (r[1] + q1) + d2 * (r[2] + q2);
+    S q0, q1, q2;
+    const S z = physics::edge_strain(u[3 * a] - u[3 * b], u[3 * a + 1] - u[3 * b + 1], u[3 * a + 2] - u[3 * b + 2], r[0],
+                                     r[1], r[2], q0, q1, q2);
     const index_t k = slot(e);
     p[3 * std::size_t(k)] = q0;
     p[3 * std::size_t(k) + 1] = q1;
     p[3 * std::size_t(k) + 2] = q2;
     zeta[k] = z;
-    g[k] = m.LE[e] * z;
+    g[k] = physics::own_g(m.LE[e], z);
 }
 
 // The edge loop over edges [e0, e1), out of line and scalar
@@ -163,14 +169,14 @@ EDGEFEM_KERNEL void tsep_strain_segment(const EdgeModel<S>& m, index_t e0, const
     for (index_t P = first; P < mid; ++P) {
         const index_t e1 = m.tsep_other[P];
         const double L = m.LP[P];
-        acc += L * double(zeta[e1]);
-        direct[e1] += L * z0;
+        acc += physics::pair_g(L, double(zeta[e1]));
+        direct[e1] += physics::pair_g(L, z0);
     }
     for (index_t P = mid; P < last; ++P) {
         const index_t e1 = m.tsep_other[P];
         const double L = m.LP[P];
-        acc += L * double(zeta[e1]);
-        out.spill[e1 - out.end] += L * z0;
+        acc += physics::pair_g(L, double(zeta[e1]));
+        out.spill[e1 - out.end] += physics::pair_g(L, z0);
     }
     g[e0] += acc;
 }
@@ -185,7 +191,7 @@ EDGEFEM_KERNEL void edge_force(const EdgeModel<S>& m, index_t e, const S* __rest
                        S* __restrict f) {
     const index_t a = m.edge[e][0], b = m.edge[e][1];
     for (int r = 0; r < 3; ++r) {
-        const S v = p[3 * std::size_t(e) + r] * S(g[e]);
+        const S v = physics::edge_force(p[3 * std::size_t(e) + r], S(g[e]));
         f[3 * a + r] += v;
         f[3 * b + r] -= v;
     }
@@ -196,7 +202,8 @@ EDGEFEM_KERNEL void edge_force(const EdgeModel<S>& m, index_t e, const S* __rest
 // tsep_force_segment, which must stay bitwise equal.
 template <class S>
 EDGEFEM_KERNEL void edge_force_terms(const S* __restrict p, index_t e, S gs, S& acc0, S& acc1, S& acc2, S* fb) {
-    const S v0 = p[3 * std::size_t(e)] * gs, v1 = p[3 * std::size_t(e) + 1] * gs, v2 = p[3 * std::size_t(e) + 2] * gs;
+    const S v0 = physics::edge_force(p[3 * std::size_t(e)], gs), v1 = physics::edge_force(p[3 * std::size_t(e) + 1], gs),
+            v2 = physics::edge_force(p[3 * std::size_t(e) + 2], gs);
     acc0 += v0;
     acc1 += v1;
     acc2 += v2;
@@ -257,8 +264,8 @@ EDGEFEM_KERNEL void tsep_force_segment(const EdgeModel<S>& m, index_t a, const S
         for (index_t P = first[e]; P < first[e + 1]; ++P) {
             const index_t e1 = other[P];
             const double L = LP[P];
-            s += L * double(zeta[e1]);
-            g[e1] += L * z0;
+            s += physics::pair_g(L, double(zeta[e1]));
+            g[e1] += physics::pair_g(L, z0);
         }
         const double ge = g[e] + s;
         g[e] = ge;
@@ -298,52 +305,34 @@ EDGEFEM_KERNEL void edge_force_add(const EdgeModel<S>& m, index_t e, const S* __
     const index_t a = m.edge[e][0];
     S* fb = forward_row<3>(fout, m.edge[e][1]);
     for (int r = 0; r < 3; ++r) {
-        const S v = p[3 * std::size_t(e) + r] * S(dg);
+        const S v = physics::edge_force(p[3 * std::size_t(e) + r], S(dg));
         f[3 * std::size_t(a) + r] += v;
         fb[r] -= v;
     }
 }
 
-// Edge term of the stiffness: K(E) = -g I - 2 L(E) p~ p~^T (overwrites).
-// `Definite` uses max(g, 0) instead of g: the Hessian is J^T A J (positive
-// semi-definite) plus the edge Laplacian weighted by g, so only edges with
-// g < 0 can make K indefinite (formulation.md section 5; forces unchanged).
+// Edge term of the stiffness, physics::edge_stiffness (overwrites K(E));
+// `Definite`: g clamped at zero.
 template <bool Definite = false, class S>
 EDGEFEM_KERNEL void edge_stiffness(const EdgeModel<S>& m, index_t e, const S* __restrict p, const double* __restrict g,
                            S* __restrict K) {
-    const S* q = &p[3 * std::size_t(e)];
-    S* k = &K[9 * std::size_t(e)];
-    const S c = -2 * m.LE[e];
-    const S ge = Definite ? S(std::max(g[e], 0.0)) : S(g[e]);
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) k[3 * i + j] = c * q[i] * q[j] - (i == j ? ge : S(0));
+    physics::edge_stiffness(m.LE[e], S(physics::stiffness_g(g[e], Definite)), &p[3 * std::size_t(e)], &K[9 * std::size_t(e)]);
 }
 
-// TSEP term for the segment of first edge e0: Kp = 2 L(P) p~(E0) p~(E1)^T
-// added with sign (-1)^(i+j) to each of its 4 targets, transposed where the
-// target edge runs the other way: K(E2) += s c x y^T with (x, y) = (p0, p1),
-// or (p1, p0) when transposed, picked by indexing, not by a branch. (A
-// scratch Kp written then re-read as vectors stalled on store forwarding.)
+// TSEP terms for the segment of first edge e0 (physics/tsep_stiffness.hpp)
+// added to each pair's 4 targets, with (x, y) = (p0, p1), or (p1, p0) when
+// transposed, picked by indexing, not by a branch. (A scratch Kp written
+// then re-read as vectors stalled on store forwarding.)
 template <class S>
 EDGEFEM_KERNEL void tsep_stiffness_segment(const EdgeModel<S>& m, index_t e0, const S* __restrict p, S* __restrict K) {
     const S* p0 = &p[3 * std::size_t(e0)];
     for (index_t P = m.tsep_first[e0]; P < m.tsep_first[e0 + 1]; ++P) {
-        const S* p1 = &p[3 * std::size_t(m.tsep_other[P])];
-        const S c = 2 * m.LP[P];
-        const S* ends[2] = {p0, p1};
+        const S* ends[2] = {p0, &p[3 * std::size_t(m.tsep_other[P])]};
+        const S c = physics::pair_coefficient(m.LP[P]);
         for (int k = 0; k < 4; ++k) {
             const index_t t = m.target[P][k];
-            const S* x = ends[t & 1];
-            const S* y = ends[(t & 1) ^ 1];
-            const S cs = (k == 0 || k == 3) ? c : -c;
-            const S y0 = y[0], y1 = y[1], y2 = y[2];
-            S* blk = &K[9 * std::size_t(t >> 1)];
-            for (int i = 0; i < 3; ++i) {
-                const S xi = cs * x[i];
-                blk[3 * i] += xi * y0;
-                blk[3 * i + 1] += xi * y1;
-                blk[3 * i + 2] += xi * y2;
-            }
+            physics::add_pair_block(physics::slot_coefficient(c, k), ends[t & 1], ends[(t & 1) ^ 1],
+                                    &K[9 * std::size_t(t >> 1)]);
         }
     }
 }
@@ -356,8 +345,8 @@ EDGEFEM_KERNEL void edge_kx(const EdgeModel<S>& m, index_t e, const S* __restric
     const S* k = &K[9 * std::size_t(e)];
     const S d[3] = {x[3 * a] - x[3 * b], x[3 * a + 1] - x[3 * b + 1], x[3 * a + 2] - x[3 * b + 2]};
     for (int i = 0; i < 3; ++i) {
-        y[3 * a + i] -= k[3 * i] * d[0] + k[3 * i + 1] * d[1] + k[3 * i + 2] * d[2];
-        y[3 * b + i] += k[i] * d[0] + k[3 + i] * d[1] + k[6 + i] * d[2];
+        y[3 * a + i] -= physics::row_times(k[3 * i], k[3 * i + 1], k[3 * i + 2], d[0], d[1], d[2]);
+        y[3 * b + i] += physics::transpose_times(k[i], k[3 + i], k[6 + i], d[0], d[1], d[2]);
     }
 }
 
@@ -389,12 +378,12 @@ EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* _
             const S* k = &K[9 * std::size_t(e)];
             const V d = xa - load(&x[W * std::size_t(V1(e))]);
             const V k0 = X::row(k), k1 = X::row(k + 3), k2 = X::row(k + 6);
-            r0 += k0 * d;
-            r1 += k1 * d;
-            r2 += k2 * d;
+            r0 += physics::row_products(k0, d);
+            r1 += physics::row_products(k1, d);
+            r2 += physics::row_products(k2, d);
             // y(V1) is summed into last: its chain through memory (the next
             // segment often updates the same vertex) stays one add long.
-            const V t = d[0] * k0 + d[1] * k1 + d[2] * k2;
+            const V t = physics::transpose_times(k0, k1, k2, d[0], d[1], d[2]);
             if constexpr (W == 4) {
                 const V s = X::row(yb) + t;
                 __builtin_memcpy(yb, &s, sizeof s);
@@ -414,12 +403,12 @@ EDGEFEM_KERNEL void edge_kx_segment(const EdgeModel<S>& m, index_t a, const S* _
             const S* k = &K[9 * std::size_t(e)];
             const S d0 = xa0 - x[W * std::size_t(b)], d1 = xa1 - x[W * std::size_t(b) + 1],
                     d2 = xa2 - x[W * std::size_t(b) + 2];
-            acc0 += k[0] * d0 + k[1] * d1 + k[2] * d2;
-            acc1 += k[3] * d0 + k[4] * d1 + k[5] * d2;
-            acc2 += k[6] * d0 + k[7] * d1 + k[8] * d2;
-            yb[0] += k[0] * d0 + k[3] * d1 + k[6] * d2;
-            yb[1] += k[1] * d0 + k[4] * d1 + k[7] * d2;
-            yb[2] += k[2] * d0 + k[5] * d1 + k[8] * d2;
+            acc0 += physics::row_times(k[0], k[1], k[2], d0, d1, d2);
+            acc1 += physics::row_times(k[3], k[4], k[5], d0, d1, d2);
+            acc2 += physics::row_times(k[6], k[7], k[8], d0, d1, d2);
+            yb[0] += physics::transpose_times(k[0], k[3], k[6], d0, d1, d2);
+            yb[1] += physics::transpose_times(k[1], k[4], k[7], d0, d1, d2);
+            yb[2] += physics::transpose_times(k[2], k[5], k[8], d0, d1, d2);
         });
         y[W * std::size_t(a)] -= acc0;
         y[W * std::size_t(a) + 1] -= acc1;
@@ -465,20 +454,17 @@ EDGEFEM_KERNEL void unpad_xyz(const S* __restrict x4, S* __restrict x, index_t b
 // Diagonal blocks: D(V0) -= K(E), D(V1) -= K(E)^T (translation invariance).
 template <class S>
 EDGEFEM_KERNEL void edge_diagonal(const EdgeModel<S>& m, index_t e, const S* __restrict K, S* __restrict D) {
-    const index_t a = m.edge[e][0], b = m.edge[e][1];
     const S* k = &K[9 * std::size_t(e)];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            D[9 * std::size_t(a) + 3 * i + j] -= k[3 * i + j];
-            D[9 * std::size_t(b) + 3 * i + j] -= k[3 * j + i];
-        }
+    physics::subtract_block(k, &D[9 * std::size_t(m.edge[e][0])]);
+    physics::subtract_block_transposed(k, &D[9 * std::size_t(m.edge[e][1])]);
 }
 
 // Diagonal blocks over the segment of edges whose V0 is `a` (D(V1) through
-// `out`, as in the segment kernels above): D(a) -= the segment's sum of its
-// K(E), summed in registers (edge by edge in memory it chained 9 stores per
-// edge to the same block: edge_diagonal_blocks was 4-5 % of an armadillo-7k
-// step).
+// `out`, as in the segment kernels above): the segment's terms of D(a)
+// summed in registers and added once (edge by edge in memory it chained 9
+// stores per edge to the same block: edge_diagonal_blocks was 4-5 % of an
+// armadillo-7k step). -(a + b) = (-a) - b exactly, so the sum of the
+// negated terms is the negated sum of the terms.
 template <class S>
 EDGEFEM_KERNEL void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D,
                                   const ForwardOut<S>& out) {
@@ -486,14 +472,11 @@ EDGEFEM_KERNEL void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, cons
     for_segment<9>(m.edge_first[a], m.edge_first[a + 1], second_vertex(m), out,
                    [&](index_t e, S* db) {
                        const S* k = &K[9 * std::size_t(e)];
-                       for (int i = 0; i < 3; ++i)
-                           for (int j = 0; j < 3; ++j) {
-                               acc[3 * i + j] += k[3 * i + j];
-                               db[3 * i + j] -= k[3 * j + i];
-                           }
+                       physics::subtract_block(k, acc);
+                       physics::subtract_block_transposed(k, db);
                    });
     S* da = &D[9 * std::size_t(a)];
-    for (int q = 0; q < 9; ++q) da[q] -= acc[q];
+    for (int q = 0; q < 9; ++q) da[q] += acc[q];
 }
 template <class S>
 EDGEFEM_KERNEL void edge_diagonal_segment(const EdgeModel<S>& m, index_t a, const S* __restrict K, S* __restrict D) {
@@ -520,8 +503,8 @@ double edge_forces(const EdgeModel<S>& m, const S* u, S* f, EdgeState<S>& st) {
         for (index_t a = 0; a < m.num_vertices; ++a) kernel::edge_force_segment(m, a, st.p.data(), st.g.data(), f);
     double W = 0;
     if constexpr (Energy)
-        for (index_t e = 0; e < ne; ++e) W += double(st.zeta[e]) * st.g[e];
-    return 0.25 * W;
+        for (index_t e = 0; e < ne; ++e) W += physics::energy_term(double(st.zeta[e]), st.g[e]);
+    return physics::energy_from_terms(W);
 }
 
 // Per-edge tangent stiffness from the state of the last edge_forces call

@@ -28,6 +28,9 @@
 #include <vector>
 
 #include "edgefem/core/edge_model.hpp"
+#include "edgefem/physics/edge_force.hpp"
+#include "edgefem/physics/edge_g.hpp"
+#include "edgefem/physics/edge_strain.hpp"
 
 namespace edgefem {
 
@@ -208,15 +211,13 @@ inline void layout_edge_strain(const LayoutModel<V, S, T>& m, const Vec3Array<V,
     const index_t ne = m.num_edges();
     for (index_t e = 0; e < ne; ++e) {
         const std::size_t a = s * std::size_t(edge[e][0]), b = s * std::size_t(edge[e][1]), i = s * std::size_t(e);
-        const S d0 = ux[a] - ux[b], d1 = uy[a] - uy[b], d2 = uz[a] - uz[b];
-        const S r0 = rx[i], r1 = ry[i], r2 = rz[i];
-        const S q0 = r0 + d0, q1 = r1 + d1, q2 = r2 + d2;
-        const S z = d0 * (r0 + q0) + d1 * (r1 + q1) + d2 * (r2 + q2);
+        S q0, q1, q2;
+        const S z = physics::edge_strain(ux[a] - ux[b], uy[a] - uy[b], uz[a] - uz[b], rx[i], ry[i], rz[i], q0, q1, q2);
         px[i] = q0;
         py[i] = q1;
         pz[i] = q2;
         zeta[e] = z;
-        g[e] = LE[e] * z;
+        g[e] = physics::own_g(LE[e], z);
     }
 }
 
@@ -249,8 +250,8 @@ inline void layout_tsep_strain(const LayoutModel<V, S, T>& m, LayoutState<V, S>&
             index_t e1;
             double L;
             tsep_record(m.tsep, P, e1, L);
-            acc += L * double(zeta[e1]);
-            g[e1] += L * z0;
+            acc += physics::pair_g(L, double(zeta[e1]));
+            g[e1] += physics::pair_g(L, z0);
         }
         g[e0] += acc;
     }
@@ -277,7 +278,8 @@ inline void layout_edge_scatter(const LayoutModel<V, S, T>& m, const LayoutState
         for (index_t e = first[a]; e < first[a + 1]; ++e) {
             const std::size_t b = s * std::size_t(edge[e][1]), i = s * std::size_t(e);
             const S ge = S(g[e]);
-            const S v0 = px[i] * ge, v1 = py[i] * ge, v2 = pz[i] * ge;
+            const S v0 = physics::edge_force(px[i], ge), v1 = physics::edge_force(py[i], ge),
+                    v2 = physics::edge_force(pz[i], ge);
             acc0 += v0;
             acc1 += v1;
             acc2 += v2;

@@ -12,19 +12,16 @@
 
 #include "edgefem/core/kernel_inline.hpp"
 #include "edgefem/core/tet_model.hpp"
+#include "edgefem/physics/tet_stvk.hpp"
 
 namespace edgefem {
 
 namespace kernel {
 
-// H = Du Dm^-1 and the volume-scaled S of a batch's tets.
+// H = Du Dm^-1 and the volume-scaled S of a batch's tets
+// (physics::tet_deformation, one tet per lane).
 template <class S>
-struct BatchDeformation {
-    using V = typename TetBatch<S>::V;
-    V H[3][3];
-    V Sv[3][3];
-    V energy;  // Vol * (lambda/2 tr(G)^2 + mu G:G), when asked for
-};
+using BatchDeformation = physics::TetDeformation<typename TetBatch<S>::V>;
 
 template <bool Energy, class S>
 EDGEFEM_KERNEL void batch_deformation(const TetBatch<S>& bt, const S* __restrict u, BatchDeformation<S>& d) {
@@ -33,25 +30,7 @@ EDGEFEM_KERNEL void batch_deformation(const TetBatch<S>& bt, const S* __restrict
     for (int i = 0; i < 4; ++i)
         for (int r = 0; r < 3; ++r)
             U[i][r] = V{u[3 * bt.v[i][0] + r], u[3 * bt.v[i][1] + r], u[3 * bt.v[i][2] + r], u[3 * bt.v[i][3] + r]};
-    V D[3][3];  // column c: u(v_{c+1}) - u(v_0)
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) D[r][c] = U[c + 1][r] - U[0][r];
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) d.H[r][c] = D[r][0] * bt.Dinv[0][c] + D[r][1] * bt.Dinv[1][c] + D[r][2] * bt.Dinv[2][c];
-    const auto& H = d.H;
-    V G[3][3];  // symmetric: the upper triangle computed
-    for (int i = 0; i < 3; ++i)
-        for (int j = i; j < 3; ++j)
-            G[j][i] = G[i][j] = S(0.5) * (H[i][j] + H[j][i] + H[0][i] * H[0][j] + H[1][i] * H[1][j] + H[2][i] * H[2][j]);
-    const V tr = G[0][0] + G[1][1] + G[2][2];
-    const V two_mu = 2 * bt.vol_mu, ltr = bt.vol_lambda * tr;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) d.Sv[i][j] = two_mu * G[i][j] + (i == j ? ltr : V{});
-    if constexpr (Energy) {
-        const V off = G[0][1] * G[0][1] + G[0][2] * G[0][2] + G[1][2] * G[1][2];
-        const V GG = G[0][0] * G[0][0] + G[1][1] * G[1][1] + G[2][2] * G[2][2] + 2 * off;
-        d.energy = S(0.5) * bt.vol_lambda * tr * tr + bt.vol_mu * GG;
-    }
+    physics::tet_deformation<Energy, S>(U, bt.Dinv, bt.vol_lambda, bt.vol_mu, d);
 }
 
 // Forces of a batch's tets scattered into f; returns their energies (with
@@ -64,19 +43,8 @@ EDGEFEM_KERNEL typename TetBatch<S>::V batch_force(const TetBatch<S>& bt, const 
     using V = typename TetBatch<S>::V;
     BatchDeformation<S> d;
     batch_deformation<Energy>(bt, u, d);
-    V P[3][3];  // P = F S = S + H S
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-            P[r][c] = d.Sv[r][c] + d.H[r][0] * d.Sv[0][c] + d.H[r][1] * d.Sv[1][c] + d.H[r][2] * d.Sv[2][c];
     V Fi[4][3];
-    for (int r = 0; r < 3; ++r) {
-        V sum = {};
-        for (int i = 0; i < 3; ++i) {
-            Fi[i + 1][r] = P[r][0] * bt.Dinv[i][0] + P[r][1] * bt.Dinv[i][1] + P[r][2] * bt.Dinv[i][2];
-            sum += Fi[i + 1][r];
-        }
-        Fi[0][r] = -sum;
-    }
+    physics::tet_forces(d, bt.Dinv, Fi);
 #pragma GCC unroll 4
     for (int l = 0; l < kTetBatchLanes; ++l)
 #pragma GCC unroll 4
@@ -128,52 +96,20 @@ EDGEFEM_KERNEL void transpose4(V v0, V v1, V v2, V v3, V (&out)[4]) {
     }
 }
 
-// The terms of a batch's stiffness values, with the arithmetic of
-// tet_stiffness per entry: (mu aa) FFt_rc + (lambda Fa_ir) Fa_jc +
-// (mu Fa_jr) Fa_ic, + aSa on the diagonal.
+// The terms of a batch's stiffness values (physics::TetStiffnessTerms, one
+// tet per lane), and value e of the TetStiffness order.
 template <class S>
-struct BatchStiffnessTerms {
+struct BatchStiffnessTerms : physics::TetStiffnessTerms<typename TetBatch<S>::V> {
     using V = typename TetBatch<S>::V;
-    V Fa[4][3], LFa[4][3], MFa[4][3], FFt[3][3], aSa[10], Maa[10];
-
-    // Value e of the TetStiffness order, one lane per tet.
     EDGEFEM_KERNEL V value(int e) const {
         const TetStiffnessEntry x = kTetStiffnessEntries[e];
-        V k = FFt[x.r][x.c] * Maa[x.block] + Fa[x.j][x.c] * LFa[x.i][x.r] + Fa[x.i][x.c] * MFa[x.j][x.r];
-        if (x.r == x.c) k += aSa[x.block];
-        return k;
+        return physics::tet_stiffness_entry<V>(*this, x.i, x.j, x.r, x.c);
     }
 };
 
 template <class S>
 EDGEFEM_KERNEL void batch_stiffness_terms(const TetBatch<S>& bt, const BatchDeformation<S>& d, BatchStiffnessTerms<S>& k) {
-    using V = typename TetBatch<S>::V;
-    V F[3][3];
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) F[r][c] = d.H[r][c] + (r == c ? S(1) : S(0));
-    V a[4][3];  // gradients of the barycentric coordinates
-    for (int c = 0; c < 3; ++c) {
-        a[1][c] = bt.Dinv[0][c];
-        a[2][c] = bt.Dinv[1][c];
-        a[3][c] = bt.Dinv[2][c];
-        a[0][c] = -(a[1][c] + a[2][c] + a[3][c]);
-    }
-    const V L = bt.vol_lambda, M = bt.vol_mu;
-    V Sa[4][3];
-    for (int i = 0; i < 4; ++i)
-        for (int r = 0; r < 3; ++r) {
-            k.Fa[i][r] = F[r][0] * a[i][0] + F[r][1] * a[i][1] + F[r][2] * a[i][2];
-            Sa[i][r] = d.Sv[r][0] * a[i][0] + d.Sv[r][1] * a[i][1] + d.Sv[r][2] * a[i][2];
-            k.LFa[i][r] = L * k.Fa[i][r];
-            k.MFa[i][r] = M * k.Fa[i][r];
-        }
-    for (int r = 0; r < 3; ++r)
-        for (int c = r; c < 3; ++c) k.FFt[c][r] = k.FFt[r][c] = F[r][0] * F[c][0] + F[r][1] * F[c][1] + F[r][2] * F[c][2];
-    for (int i = 0; i < 4; ++i)
-        for (int j = i; j < 4; ++j) {
-            k.aSa[tet_block_index(i, j)] = a[i][0] * Sa[j][0] + a[i][1] * Sa[j][1] + a[i][2] * Sa[j][2];
-            k.Maa[tet_block_index(i, j)] = M * (a[i][0] * a[j][0] + a[i][1] * a[j][1] + a[i][2] * a[j][2]);
-        }
+    physics::tet_stiffness_terms<S>(d, bt.Dinv, bt.vol_lambda, bt.vol_mu, k);
 }
 
 // The last batch when it has padding lanes: its real lanes, value by value.

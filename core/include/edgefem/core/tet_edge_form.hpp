@@ -32,6 +32,7 @@
 #include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh.hpp"
 #include "edgefem/core/topology.hpp"
+#include "edgefem/physics/tet_local_form.hpp"
 
 namespace edgefem {
 
@@ -50,10 +51,6 @@ inline constexpr int kTetLanes = std::is_same_v<S, float> ? 8 : 4;
 inline constexpr int kFormRows = 15;
 inline constexpr int kSym[6][6] = {{-1, 0, 1, 2, 3, 4},  {0, -1, 5, 6, 7, 8},   {1, 5, -1, 9, 10, 11},
                                    {2, 6, 9, -1, 12, 13}, {3, 7, 10, 12, -1, 14}, {4, 8, 11, 13, 14, -1}};
-// The 3 local edges at each local vertex, and the vertex's sign in them
-// (+1: the edge's first end, p~ = x_first - x_second).
-inline constexpr int kVertexEdges[4][3] = {{0, 1, 2}, {0, 3, 4}, {1, 3, 5}, {2, 4, 5}};
-inline constexpr int kVertexSigns[4][3] = {{1, 1, 1}, {-1, 1, 1}, {-1, -1, 1}, {-1, -1, -1}};
 
 // One tile of the serial sweeps (tet_form_forces, tet_form_stiffness_all).
 // Tile i runs the edge loop up to edge edge_end, the batches up to
@@ -217,18 +214,16 @@ inline void tet_form_strain_impl(const TetEdgeForm<S>& f, index_t b, const S* __
             for (int l = 0; l < G; ++l) z[l] = double(zeta[slot(E[k * L + l])]);
             __builtin_memcpy(&Z[k], z, sizeof(V));
         }
+        const auto coef = [&](int k, int m) {
+            double a[G];
+            for (int l = 0; l < G; ++l) a[l] = double(A[kSym[k][m] * L + l]);
+            V av;
+            __builtin_memcpy(&av, a, sizeof(V));
+            return av;
+        };
 #pragma GCC unroll 6
         for (int k = 0; k < 6; ++k) {
-            V s = {};
-#pragma GCC unroll 6
-            for (int m = 0; m < 6; ++m) {
-                if (m == k) continue;  // the diagonal stays with the edges (L(E))
-                double a[G];
-                for (int l = 0; l < G; ++l) a[l] = double(A[kSym[k][m] * L + l]);
-                V av;
-                __builtin_memcpy(&av, a, sizeof(V));
-                s += av * Z[m];
-            }
+            const V s = physics::form_g(k, coef, Z);
             if (n - h >= G) {
 #pragma GCC unroll 4
                 for (int l = 0; l < G; ++l) add(E[k * L + l], s[l]);
@@ -354,26 +349,14 @@ inline void tet_form_stiffness_impl(const TetEdgeForm<S>& f, index_t b, const S*
     for (int k = 0; k < 6; ++k)
         for (int c = 0; c < 3; ++c)
             for (int l = 0; l < L; ++l) P[k][c][l] = p[3 * std::size_t(E[k * L + l]) + c];
-    // W[k][v] = sum over the edges m at vertex v of s_mv A_km p~_m.
     V W[6][4][3];
-#pragma GCC unroll 6
-    for (int k = 0; k < 6; ++k)
-#pragma GCC unroll 4
-        for (int v = 0; v < 4; ++v) {
-            const int m0 = kVertexEdges[v][0], m1 = kVertexEdges[v][1], m2 = kVertexEdges[v][2];
-            const V a0 = S(kVertexSigns[v][0]) * row(k, m0), a1 = S(kVertexSigns[v][1]) * row(k, m1),
-                    a2 = S(kVertexSigns[v][2]) * row(k, m2);
-            for (int c = 0; c < 3; ++c) W[k][v][c] = a0 * P[m0][c] + a1 * P[m1][c] + a2 * P[m2][c];
-        }
-    // K_ab = 2 sum over the edges k at a of s_ka p~_k W[k][b]^T. Padding
-    // lanes of the last batch write the sink block K(#E).
+    physics::form_w<S>(row, P, W);
+    // The 6 blocks K_ab (physics::form_block). Padding lanes of the last
+    // batch write the sink block K(#E).
     const int n = f.batch_size(b);
     S* const sink = &K[9 * std::size_t(f.num_edges)];
 #pragma GCC unroll 6
     for (int e = 0; e < 6; ++e) {
-        const int a = kTetEdge[e][0], bv = kTetEdge[e][1];
-        const int k0 = kVertexEdges[a][0], k1 = kVertexEdges[a][1], k2 = kVertexEdges[a][2];
-        const S s0 = S(2 * kVertexSigns[a][0]), s1 = S(2 * kVertexSigns[a][1]), s2 = S(2 * kVertexSigns[a][2]);
         S* blk[L];
         for (int l = 0; l < L; ++l) {
             const index_t t = E[e * L + l];
@@ -383,10 +366,7 @@ inline void tet_form_stiffness_impl(const TetEdgeForm<S>& f, index_t b, const S*
                 blk[l] = l < n ? &K[9 * std::size_t(t)] : sink;
         }
         V kv[9];
-        for (int i = 0; i < 3; ++i) {
-            const V x0 = s0 * P[k0][i], x1 = s1 * P[k1][i], x2 = s2 * P[k2][i];
-            for (int j = 0; j < 3; ++j) kv[3 * i + j] = x0 * W[k0][bv][j] + x1 * W[k1][bv][j] + x2 * W[k2][bv][j];
-        }
+        physics::form_block<S>(e, P, W, kv);
         scatter_blocks(kv, blk);
     }
 }
@@ -465,9 +445,9 @@ double tet_form_forces_on(const EdgeModel<S>& m, const TetEdgeForm<S>& form, con
             for (index_t a = prev.vertex_end; a < t.vertex_end; ++a) kernel::edge_force_segment(m, a, p, g, f, out, slot);
         if constexpr (Energy)
             for (index_t e = m.edge_first[prev.vertex_end]; e < m.edge_first[t.vertex_end]; ++e)
-                W += double(zeta[slot(e)]) * g[slot(e)];
+                W += physics::energy_term(double(zeta[slot(e)]), g[slot(e)]);
     });
-    return 0.25 * W;
+    return physics::energy_from_terms(W);
 }
 
 // Forces (and the energy when `Energy`); leaves p~, zeta, g in `st` for

@@ -12,115 +12,63 @@
 #include "edgefem/core/tet_batch_kernels.hpp"
 #include "edgefem/core/tet_model.hpp"
 #include "edgefem/core/xyz4.hpp"
+#include "edgefem/physics/edge_blocks.hpp"
+#include "edgefem/physics/tet_stvk.hpp"
 
 namespace edgefem {
 
 namespace kernel {
 
-// Deformation of one tet: F = I + H and the volume-scaled second
-// Piola-Kirchhoff stress S (so P = F S is volume-scaled too).
+// The displacements of tet t's vertices, as the per-tet formulas take them.
 template <class S>
-struct TetDeformation {
-    S F[3][3];
-    S Sv[3][3];
-    S energy;  // Vol * (lambda/2 tr(G)^2 + mu G:G)
-};
-
-template <class S>
-EDGEFEM_KERNEL void tet_deformation(const TetModel<S>& m, index_t t, const S* __restrict u, TetDeformation<S>& out) {
+EDGEFEM_KERNEL void tet_displacements(const TetModel<S>& m, index_t t, const S* __restrict u, S (&U)[4][3]) {
     const auto& v = m.tet[t];
-    const auto& d = m.data[t];
-    S D[3][3];  // column c: u(v_{c+1}) - u(v_0)
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) D[r][c] = u[3 * v[c + 1] + r] - u[3 * v[0] + r];
-    S H[3][3];
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) H[r][c] = D[r][0] * d.Dinv[0][c] + D[r][1] * d.Dinv[1][c] + D[r][2] * d.Dinv[2][c];
-    S G[3][3];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            G[i][j] = S(0.5) * (H[i][j] + H[j][i] + H[0][i] * H[0][j] + H[1][i] * H[1][j] + H[2][i] * H[2][j]);
-    const S tr = G[0][0] + G[1][1] + G[2][2];
-    S GG = 0;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            out.Sv[i][j] = 2 * d.vol_mu * G[i][j] + (i == j ? d.vol_lambda * tr : S(0));
-            out.F[i][j] = H[i][j] + (i == j ? S(1) : S(0));
-            GG += G[i][j] * G[i][j];
-        }
-    out.energy = S(0.5) * d.vol_lambda * tr * tr + d.vol_mu * GG;
+    for (int i = 0; i < 4; ++i)
+        for (int r = 0; r < 3; ++r) U[i][r] = u[3 * v[i] + r];
 }
 
-// Gradients a_0..a_3 of the tet's barycentric coordinates.
+// The deformation of tet t at displacement u (physics::tet_deformation).
+template <bool Energy, class S>
+EDGEFEM_KERNEL physics::TetDeformation<S> tet_deformation(const TetModel<S>& m, index_t t, const S* __restrict u) {
+    S U[4][3];
+    tet_displacements(m, t, u, U);
+    const auto& d = m.data[t];
+    physics::TetDeformation<S> def;
+    physics::tet_deformation<Energy, S>(U, d.Dinv, d.vol_lambda, d.vol_mu, def);
+    return def;
+}
+
+// y[v_i] += dy[i] for tet t's vertices.
 template <class S>
-EDGEFEM_KERNEL void tet_grads(const TetData<S>& d, S a[4][3]) {
-    for (int c = 0; c < 3; ++c) {
-        a[1][c] = d.Dinv[0][c];
-        a[2][c] = d.Dinv[1][c];
-        a[3][c] = d.Dinv[2][c];
-        a[0][c] = -(a[1][c] + a[2][c] + a[3][c]);
-    }
+EDGEFEM_KERNEL void tet_scatter(const TetModel<S>& m, index_t t, const S (&dy)[4][3], S* __restrict y) {
+    const auto& v = m.tet[t];
+    for (int i = 0; i < 4; ++i)
+        for (int r = 0; r < 3; ++r) y[3 * v[i] + r] += dy[i][r];
 }
 
 // Forces of one tet scattered into f; returns its energy. (Built-in
 // scalars run the batched form, tet_batch_kernels.hpp, in the loops.)
 template <class S>
 EDGEFEM_KERNEL S tet_force(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict f) {
-    TetDeformation<S> def;
-    tet_deformation(m, t, u, def);
-    S P[3][3];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            P[i][j] = def.F[i][0] * def.Sv[0][j] + def.F[i][1] * def.Sv[1][j] + def.F[i][2] * def.Sv[2][j];
-    const auto& v = m.tet[t];
-    const auto& d = m.data[t];
-    for (int r = 0; r < 3; ++r) {
-        S sum = 0;
-        for (int i = 0; i < 3; ++i) {
-            const S fi = P[r][0] * d.Dinv[i][0] + P[r][1] * d.Dinv[i][1] + P[r][2] * d.Dinv[i][2];
-            f[3 * v[i + 1] + r] += fi;
-            sum += fi;
-        }
-        f[3 * v[0] + r] -= sum;
-    }
+    const physics::TetDeformation<S> def = tet_deformation<true>(m, t, u);
+    S fi[4][3];
+    physics::tet_forces(def, m.data[t].Dinv, fi);
+    tet_scatter(m, t, fi, f);
     return def.energy;
 }
 
-// The 10 stiffness blocks of one tet at displacement u:
-// K_ab = (a_a . S a_b) I + lambda (F a_a)(F a_b)^T + mu (a_a . a_b) F F^T + mu (F a_b)(F a_a)^T
-// (all volume-scaled), from dP = dF S + F dS with dS = lambda tr(dG) I + 2 mu dG.
-// Per entry: (mu aa) FFt_rc + (lambda Fa_ir) Fa_jc + (mu Fa_jr) Fa_ic, + aSa
-// on the diagonal. (Built-in scalars run the batched form in the loops.)
+// The 10 stiffness blocks of one tet at displacement u (physics::
+// tet_stiffness_entry). (Built-in scalars run the batched form in the loops.)
 template <class S>
 EDGEFEM_KERNEL void tet_stiffness(const TetModel<S>& m, index_t t, const S* __restrict u, S* __restrict Kt) {
-    TetDeformation<S> def;
-    tet_deformation(m, t, u, def);
+    const physics::TetDeformation<S> def = tet_deformation<false>(m, t, u);
     const auto& d = m.data[t];
-    S a[4][3];
-    tet_grads(d, a);
-    // Material constants without the volume: Sv already carries it, and
-    // vol_lambda / vol_mu carry it for the other terms.
-    const S L = d.vol_lambda, M = d.vol_mu;
-    S Fa[4][3], Sa[4][3], FFt[3][3];
+    physics::TetStiffnessTerms<S> k;
+    physics::tet_stiffness_terms<S>(def, d.Dinv, d.vol_lambda, d.vol_mu, k);
     for (int i = 0; i < 4; ++i)
-        for (int r = 0; r < 3; ++r) {
-            Fa[i][r] = def.F[r][0] * a[i][0] + def.F[r][1] * a[i][1] + def.F[r][2] * a[i][2];
-            Sa[i][r] = def.Sv[r][0] * a[i][0] + def.Sv[r][1] * a[i][1] + def.Sv[r][2] * a[i][2];
-        }
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-            FFt[r][c] = def.F[r][0] * def.F[c][0] + def.F[r][1] * def.F[c][1] + def.F[r][2] * def.F[c][2];
-    for (int i = 0; i < 4; ++i)
-        for (int j = i; j < 4; ++j) {
-            const S aSa = a[i][0] * Sa[j][0] + a[i][1] * Sa[j][1] + a[i][2] * Sa[j][2];
-            const S Maa = M * (a[i][0] * a[j][0] + a[i][1] * a[j][1] + a[i][2] * a[j][2]);
-            S* blk = &Kt[9 * tet_block_index(i, j)];
-            for (int r = 0; r < 3; ++r) {
-                const S LFa = L * Fa[i][r], MFa = M * Fa[j][r];
-                for (int c = 0; c < 3; ++c) blk[3 * r + c] = FFt[r][c] * Maa + Fa[j][c] * LFa + Fa[i][c] * MFa;
-                blk[3 * r + r] += aSa;
-            }
-        }
+        for (int j = i; j < 4; ++j)
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) Kt[9 * tet_block_index(i, j) + 3 * r + c] = physics::tet_stiffness_entry(k, i, j, r, c);
 }
 
 // y += K_t x for one tet from its stored blocks. Built-in scalars: each
@@ -142,10 +90,10 @@ EDGEFEM_KERNEL void tet_kx(const TetModel<S>& m, index_t t, const S* __restrict 
                 const S* blk = &Kt[9 * tet_block_index(i, j)];
                 // The tet's last row: 3 loads (lane 3 would be the next tet's).
                 const V k0 = X::row(blk), k1 = X::row(blk + 3), k2 = i == 3 ? X::load(blk + 6) : X::row(blk + 6);
-                rw[i][0] += k0 * xv[j];
-                rw[i][1] += k1 * xv[j];
-                rw[i][2] += k2 * xv[j];
-                if (j != i) col[j] += k0 * xv[i][0] + k1 * xv[i][1] + k2 * xv[i][2];
+                rw[i][0] += physics::row_products(k0, xv[j]);
+                rw[i][1] += physics::row_products(k1, xv[j]);
+                rw[i][2] += physics::row_products(k2, xv[j]);
+                if (j != i) col[j] += physics::transpose_times(k0, k1, k2, xv[i][0], xv[i][1], xv[i][2]);
             }
         for (int i = 0; i < 4; ++i)
             for (int r = 0; r < 3; ++r) y[3 * v[i] + r] += col[i][r] + (rw[i][r][0] + rw[i][r][1] + rw[i][r][2]);
@@ -156,10 +104,10 @@ EDGEFEM_KERNEL void tet_kx(const TetModel<S>& m, index_t t, const S* __restrict 
                 const S* xj = &x[3 * v[j]];
                 if (i <= j) {
                     const S* blk = &Kt[9 * tet_block_index(i, j)];
-                    for (int r = 0; r < 3; ++r) acc[r] += blk[3 * r] * xj[0] + blk[3 * r + 1] * xj[1] + blk[3 * r + 2] * xj[2];
+                    for (int r = 0; r < 3; ++r) acc[r] += physics::row_times(blk[3 * r], blk[3 * r + 1], blk[3 * r + 2], xj[0], xj[1], xj[2]);
                 } else {
                     const S* blk = &Kt[9 * tet_block_index(j, i)];
-                    for (int r = 0; r < 3; ++r) acc[r] += blk[r] * xj[0] + blk[3 + r] * xj[1] + blk[6 + r] * xj[2];
+                    for (int r = 0; r < 3; ++r) acc[r] += physics::transpose_times(blk[r], blk[3 + r], blk[6 + r], xj[0], xj[1], xj[2]);
                 }
             }
             for (int r = 0; r < 3; ++r) y[3 * v[i] + r] += acc[r];
@@ -167,47 +115,17 @@ EDGEFEM_KERNEL void tet_kx(const TetModel<S>& m, index_t t, const S* __restrict 
     }
 }
 
-// y += K_t(u) x for one tet without stored blocks: dF = dDx Dm^-1,
-// dP = dF S + F dS, y_i += dP a_i.
+// y += K_t(u) x for one tet without stored blocks
+// (physics::tet_stiffness_times).
 template <class S>
 EDGEFEM_KERNEL void tet_kx_matrix_free(const TetModel<S>& m, index_t t, const S* __restrict u, const S* __restrict x,
                                S* __restrict y) {
-    TetDeformation<S> def;
-    tet_deformation(m, t, u, def);
-    const auto& v = m.tet[t];
+    const physics::TetDeformation<S> def = tet_deformation<false>(m, t, u);
     const auto& d = m.data[t];
-    S dD[3][3], dF[3][3];
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) dD[r][c] = x[3 * v[c + 1] + r] - x[3 * v[0] + r];
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) dF[r][c] = dD[r][0] * d.Dinv[0][c] + dD[r][1] * d.Dinv[1][c] + dD[r][2] * d.Dinv[2][c];
-    S dG[3][3];  // sym(F^T dF)
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            S s = 0;
-            for (int k = 0; k < 3; ++k) s += def.F[k][i] * dF[k][j] + dF[k][i] * def.F[k][j];
-            dG[i][j] = S(0.5) * s;
-        }
-    const S tr = dG[0][0] + dG[1][1] + dG[2][2];
-    S dS[3][3];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) dS[i][j] = 2 * d.vol_mu * dG[i][j] + (i == j ? d.vol_lambda * tr : S(0));
-    S dP[3][3];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            S s = 0;
-            for (int k = 0; k < 3; ++k) s += dF[i][k] * def.Sv[k][j] + def.F[i][k] * dS[k][j];
-            dP[i][j] = s;
-        }
-    for (int r = 0; r < 3; ++r) {
-        S sum = 0;
-        for (int i = 0; i < 3; ++i) {
-            const S yi = dP[r][0] * d.Dinv[i][0] + dP[r][1] * d.Dinv[i][1] + dP[r][2] * d.Dinv[i][2];
-            y[3 * v[i + 1] + r] += yi;
-            sum += yi;
-        }
-        y[3 * v[0] + r] -= sum;
-    }
+    S X[4][3], dy[4][3];
+    tet_displacements(m, t, x, X);
+    physics::tet_stiffness_times<S>(def, X, d.Dinv, d.vol_lambda, d.vol_mu, dy);
+    tet_scatter(m, t, dy, y);
 }
 
 }  // namespace kernel
@@ -239,11 +157,7 @@ double tet_forces(const TetModel<S>& m, const S* u, S* f) {
 // Per-tet energies (#T), e.g. for output as energy density.
 template <class S>
 void tet_energies(const TetModel<S>& m, const S* u, double* energy) {
-    kernel::TetDeformation<S> def;
-    for (index_t t = 0; t < m.num_tets(); ++t) {
-        kernel::tet_deformation(m, t, u, def);
-        energy[t] = double(def.energy);
-    }
+    for (index_t t = 0; t < m.num_tets(); ++t) energy[t] = double(kernel::tet_deformation<true>(m, t, u).energy);
 }
 
 template <class S>

@@ -8,6 +8,7 @@
 
 #include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh.hpp"
+#include "edgefem/physics/tet_stvk.hpp"
 
 namespace edgefem {
 
@@ -89,11 +90,7 @@ struct TetStiffness {
     std::vector<S> K;  // 90 #T
 };
 
-inline constexpr int tet_block_index(int a, int b) {
-    // a <= b
-    constexpr int start[4] = {0, 4, 7, 9};
-    return start[a] + (b - a);
-}
+using physics::tet_block_index;  // block (a, b), a <= b, in that order
 
 // Throws InvalidArgument on invalid materials.
 template <class S>

@@ -9,11 +9,17 @@
 
 #include "edgefem/core/csr.hpp"
 #include "edgefem/core/mesh.hpp"
+#include "edgefem/physics/tet_local.hpp"
 
 namespace edgefem {
 
-// Local edges of a tet (a, b, c, d) = (0, 1, 2, 3), in tet_edges order.
-inline constexpr int kTetEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+// Local edges of a tet (a, b, c, d) = (0, 1, 2, 3), in tet_edges order: the
+// numbering of physics/tet_local.hpp as a table for set-up code.
+inline constexpr auto kTetEdge = [] {
+    std::array<std::array<int, 2>, 6> t{};
+    for (int e = 0; e < 6; ++e) t[e] = {physics::tet_edge_vertex(e, 0), physics::tet_edge_vertex(e, 1)};
+    return t;
+}();
 // The 15 local edge pairs of a tet: first the 12 vertex-sharing ones, then the
 // 3 opposite ones.
 inline constexpr int kTetEdgePair[15][2] = {{0, 1}, {0, 2}, {0, 3}, {0, 4}, {1, 2}, {1, 3},

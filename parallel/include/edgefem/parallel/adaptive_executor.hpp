@@ -6,9 +6,9 @@
 // the machine: on one 2-core VM a barrier took 0.27 µs and the 2-thread
 // step on box-1200 beat the serial one; on another the barrier took 1.5 µs
 // (a cache line's round trip between the two cores 0.4-0.5 µs) and the same
-// step ran 1.9x slower on 2 threads than on 1 (docs/parallel.md,
-// Update 6). No fixed size threshold fits both, so the choice is
-// measured.
+// step ran 1.9x slower on 2 threads than on 1 (measured:
+// docs/lab/parallel-log.md, Update 6). No fixed size threshold fits both,
+// so the choice is measured; docs/parallel.md, "The adaptive executor".
 //
 // How: every call site (the type of the loop body, which is unique per
 // lambda in the source, plus the loop's chunk count and kind) is timed for
@@ -20,7 +20,7 @@
 // decided sites: the mode with the smaller sum over them of calls x fastest
 // call. One mode for all, not one per site: a mix was never timed, and
 // measured slower than both (each switch moves the vectors between the
-// cores' caches; docs/parallel.md, Update 6).
+// cores' caches; measured: docs/lab/parallel-log.md, Update 6).
 // The machine may change under a long run (on a shared VM the 2-thread step
 // took 1.0 ms in one minute and 1.4 ms in the next): after `retrial`
 // calls (2^14 by default), then twice as many, ... (at most 2^22 between

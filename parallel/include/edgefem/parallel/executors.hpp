@@ -109,9 +109,9 @@ private:
 // phases of a call are separated by a spun-on barrier, so that a call on
 // busy threads starts and ends without a system call: libgomp makes one at
 // every region start, region end and barrier (futex_wake), which cost
-// 1.2-1.7 µs each on a VM with page-table isolation (docs/parallel.md,
-// Update 6). Threads beyond the hardware threads are accepted (they spin
-// less and yield). An exception from a chunk is rethrown by the call once
+// 1.2-1.7 µs each on a VM with page-table isolation (measured:
+// docs/lab/parallel-log.md, Update 6). Threads beyond the hardware threads
+// are accepted (they spin less and yield). An exception from a chunk is rethrown by the call once
 // every thread has finished (the other chunks of that call may or may not
 // have run).
 class PoolExecutor final : public ScheduledExecutor {

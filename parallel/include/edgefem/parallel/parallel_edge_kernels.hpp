@@ -410,7 +410,8 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
             else
                 owner_fused_forces(u, f, st);
             if constexpr (Energy)
-                return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
+                return physics::energy_from_terms(
+                blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return physics::energy_term(double(zeta[i]), g[i]); }));
             return 0;
         }
     each_range(ne, [&](index_t b, index_t e) {
@@ -455,7 +456,8 @@ double ParallelEdgeKernels<S>::forces(const S* u, S* f, EdgeState<S>& st) const 
         [&](index_t i, const auto& add) { kernel::edge_force_to(m, i, p, g, add); },
         [&](index_t i, S* o) { kernel::edge_force(m, i, p, g, o); });
     if constexpr (Energy)
-        return 0.25 * blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return double(zeta[i]) * g[i]; });
+        return physics::energy_from_terms(
+                blocked_sum(*ex_, std::size_t(ne), [&](std::size_t i) { return physics::energy_term(double(zeta[i]), g[i]); }));
     return 0;
 }
 

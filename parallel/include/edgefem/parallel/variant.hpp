@@ -31,9 +31,10 @@ inline bool is_deterministic(Variant v) {
 
 // Blocks of consecutive items coloured as units: with a locality ordering a
 // block is spatially compact, so each thread streams through contiguous
-// memory and few colours (barriers) are needed. Measured (docs/parallel.md):
-// one item per unit made the colour variant 2-5x slower than serial at 1
-// thread; 1024-item blocks match serial at 1 thread and beat it at 2.
+// memory and few colours (barriers) are needed. Measured
+// (docs/lab/parallel-log.md, "Which variant is fastest, and why"): one item
+// per unit made the colour variant 2-5x slower than serial at 1 thread;
+// 1024-item blocks match serial at 1 thread and beat it at 2.
 inline ColouringOptions blocked_colouring() {
     ColouringOptions o;
     o.block = 1024;
@@ -108,7 +109,8 @@ struct PlanOptions {
     ColouringOptions form_colouring = form_batch_colouring();
     // With the tet-local form, the owner variant's FE forces take g from it
     // too (owner parts of its batches) instead of the TSEP loop: 1.3-1.4x
-    // faster at 2 threads on bunny-4k to bunny-1m (docs/parallel.md). The
+    // faster at 2 threads on bunny-4k to bunny-1m (measured when the form's
+    // forces were added, commit 6a8ef14, 2026-11-22). The
     // colour variant keeps its TSEP segments: the form's batch colouring
     // has more colours, and its barriers lost at 2 threads on armadillo-7k.
     bool form_forces = true;
