@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstddef>
 
-#include "edgefem/core/host_device.hpp"
+#include "edgefem/physics/host_device.hpp"
 
 namespace edgefem::ops {
 
