@@ -28,11 +28,11 @@
 
 #include "bench_meshes.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_edge_kernels.hpp"
-#include "edgefem/parallel/stream_bandwidth.hpp"
+#include "cpu/parallel_edge_kernels.hpp"
+#include "lab/stream_bandwidth.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 

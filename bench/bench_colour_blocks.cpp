@@ -7,10 +7,10 @@
 #include <map>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "cpu/cpu_operator.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 
@@ -33,7 +33,7 @@ void BM(benchmark::State& state, std::string name, int threads, index_t block, i
     const Material mat{1e5, 0.3, 1000};
     std::unique_ptr<ElasticOperator<double>> op;
     if (threads == 0) {
-        op = make_elastic_operator<double>(mesh, mat, ModelKind::FE, Method::Edge);
+        op = make_cpu_operator<double>(mesh, mat, ModelKind::FE, Method::Edge);
     } else {
         PlanOptions o;
         // Vertex segments hold ~6 edges each: 1/6 of the block in vertices.
@@ -41,8 +41,7 @@ void BM(benchmark::State& state, std::string name, int threads, index_t block, i
         o.segment_colouring.max_chunk_items = std::max<index_t>(1024, 4 * block);
         o.vertex_colouring.block = std::max<index_t>(1, block / 6);
         o.vertex_colouring.max_chunk_items = std::max<index_t>(170, (4 * block) / 6);
-        op = make_parallel_operator<double>(mesh, mat, ModelKind::FE, Method::Edge, make_executor(Backend::TBB, threads),
-                                            Variant::Colour, o);
+        op = make_cpu_operator<double>(mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(Backend::TBB, threads), Variant::Colour}, o);
     }
     const auto u = deformation_displacement(mesh, Deformation::Twist);
     std::vector<double> f(u.size()), y(u.size());

@@ -10,10 +10,10 @@
 #include <memory>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/edge_kernels.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
-#include "edgefem/core/tet_kernels.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/edge_kernels.hpp"
+#include "cpu/tet_edge_form.hpp"
+#include "cpu/tet_kernels.hpp"
 
 using namespace edgefem;
 
@@ -44,7 +44,7 @@ template <class S>
 struct Prepared {
     EdgeModel<S> edge;
     TetEdgeForm<S> form;
-    TetModel<S> tet;
+    BatchedTetModel<S> tet;
     std::vector<S> u, x;
 };
 
@@ -59,7 +59,7 @@ const Prepared<S>& prepared(const std::string& name) {
         p = std::make_unique<Prepared<S>>();
         p->edge = make_edge_model<S>(topo, compute_coefficients(mesh, topo, mat));
         p->form = make_tet_edge_form<S>(mesh, topo, mat);
-        p->tet = make_tet_model<S>(mesh, mat);
+        p->tet = make_batched_tet_model<S>(mesh, mat);
         const auto u = deformation_displacement(mesh, Deformation::Twist);
         p->u.assign(u.begin(), u.end());
         p->x.resize(u.size());

@@ -8,7 +8,7 @@
 #include <map>
 #include <string>
 
-#include "edgefem/core/named_mesh.hpp"
+#include "lab/named_mesh.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"

@@ -15,9 +15,9 @@
 
 #include "bench_meshes.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/edge_kernels.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/edge_kernels.hpp"
+#include "cpu/tet_edge_form.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 

@@ -8,8 +8,8 @@
 //
 // Names: paper/<kernel>/<method>/<precision>/<threads>t/<mesh>, kernel in
 // force | stiffness | force+stiffness | step; method edge-fe | edge-sn | tet.
-// 1 thread runs core's serial loops (make_elastic_operator, the serial
-// Simulator); more threads run parallel/'s operators (OpenMP executor, the
+// 1 thread runs the CPU back-end's serial loops (make_cpu_operator without an
+// executor, the serial Simulator); more threads run its threaded variants (OpenMP executor, the
 // default variant Auto: owner when the mesh's numbering has locality, else
 // gather, both deterministic; the per-tet operator runs coloured) and the
 // Simulator on the same executor. The paper's meshes run renumbered by RCM,
@@ -36,14 +36,14 @@
 #include <string>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "counting_scalar.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "cpu/cpu_operator.hpp"
 #include "flop_counts.hpp"
 
 using namespace edgefem;
@@ -132,8 +132,8 @@ std::shared_ptr<const Executor> executor_for(int threads) {
 
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_op(const Mesh& mesh, Which m, int threads) {
-    if (threads == 1) return make_elastic_operator<S>(mesh, materials(), model_of(m), method_of(m));
-    return make_parallel_operator<S>(mesh, materials(), model_of(m), method_of(m), executor_for(threads));
+    if (threads == 1) return make_cpu_operator<S>(mesh, materials(), model_of(m), method_of(m));
+    return make_cpu_operator<S>(mesh, materials(), model_of(m), method_of(m), CpuOptions{executor_for(threads), Variant::Auto}, PlanOptions{});
 }
 
 Scene step_scene(const Mesh& mesh, Which m) {
@@ -154,10 +154,10 @@ void BM_Paper(benchmark::State& state, std::string mesh_name, Kernel k, Which m,
         Scene s = step_scene(mesh, m);
         std::unique_ptr<Simulator<S>> sim;
         if (threads == 1) {
-            sim = std::make_unique<Simulator<S>>(std::move(s));
+            sim = std::make_unique<Simulator<S>>(std::move(s), nullptr, cpu_operator_factory<S>());
         } else {
             auto ex = executor_for(threads);
-            sim = std::make_unique<Simulator<S>>(std::move(s), ex, parallel_operator_factory<S>(ex));
+            sim = std::make_unique<Simulator<S>>(std::move(s), ex, cpu_operator_factory<S>({ex}));
         }
         for (int i = 0; i < 3; ++i) sim->step();  // warm: K, buffers, a moving state
         for (auto _ : state) sim->step();

@@ -32,15 +32,15 @@
 #include <sstream>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "edgefem/core/cg.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
-#include "edgefem/parallel/parallel_edge_kernels.hpp"
-#include "edgefem/parallel/stream_bandwidth.hpp"
+#include "cpu/cpu_operator.hpp"
+#include "cpu/parallel_edge_kernels.hpp"
+#include "lab/stream_bandwidth.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 
@@ -227,7 +227,7 @@ void BM_Step(benchmark::State& state, std::string mesh, Backend b, Variant v, in
         OperatorFactory<double> factory;
         if (threads > 0) {
             ex = make_executor(b, threads);
-            factory = parallel_operator_factory<double>(ex, v, plan_options());
+            factory = cpu_operator_factory<double>({ex, v}, plan_options());
         }
         sim = std::make_unique<Simulator<double>>(std::move(scene), ex, factory);
         for (int i = 0; i < 3; ++i) sim->step();  // warm: K, buffers, a moving state

@@ -20,10 +20,10 @@
 
 #include "bench_meshes.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_edge_kernels.hpp"
+#include "cpu/parallel_edge_kernels.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 

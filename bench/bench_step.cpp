@@ -12,11 +12,12 @@
 #include <functional>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
 
 using namespace edgefem;
 
@@ -27,7 +28,7 @@ Scene step_scene(const Mesh& mesh) { return step_benchmark_scene(mesh, Material{
 void BM_Step(benchmark::State& state, std::string mesh_name, std::function<void(Scene&)> tweak, bool energy) {
     Scene s = step_scene(bench::bench_mesh(mesh_name));
     tweak(s);
-    Simulator<double> sim(std::move(s));
+    Simulator<double> sim(std::move(s), nullptr, cpu_operator_factory<double>());
     for (int k = 0; k < 3; ++k) sim.step();  // warm: K, buffers, a moving state
     for (auto _ : state) {
         sim.step();

@@ -12,9 +12,9 @@
 #include <cstdint>
 #include <type_traits>
 
-#include "edgefem/core/edge_kernels.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
-#include "edgefem/core/tet_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
+#include "cpu/tet_edge_form.hpp"
+#include "cpu/tet_kernels.hpp"
 
 namespace edgefem::flops {
 
@@ -81,7 +81,7 @@ struct Measured {
 inline Measured count_kernels(const EdgeModel<double>& edge_d, const TetModel<double>& tet_d,
                               const std::vector<double>& u_d, const TetEdgeForm<double>* form_d = nullptr) {
     const EdgeModel<Counted> em = counted_model(edge_d);
-    const TetModel<Counted> tm = counted_model(tet_d);
+    const BatchedTetModel<Counted> tm = make_batched_tet_model(counted_model(tet_d));
     std::vector<Counted> u(u_d.begin(), u_d.end()), f(u.size()), y(u.size()), x(u.size());
     for (std::size_t i = 0; i < x.size(); ++i) x[i] = Counted(0.001 * double(i % 7));
     Measured r;

@@ -18,7 +18,7 @@
 #include <cmath>
 
 #include "edgefem/core/edge_model.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "cpu/tet_edge_form.hpp"
 
 namespace edgefem::flops {
 

@@ -33,14 +33,14 @@
 #include <typeindex>
 
 #include "bench_meshes.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/simulator.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "cpu/cpu_operator.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/tet_edge_form.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_edge_kernels.hpp"
+#include "cpu/parallel_edge_kernels.hpp"
 
 using namespace edgefem;
 using Clock = std::chrono::steady_clock;
@@ -159,7 +159,7 @@ int step_sites(const Mesh& mesh, const std::string& name, Backend b, int threads
     auto tracer = std::make_shared<TracingExecutor>(make_executor(b, threads));
     Scene scene = step_benchmark_scene(mesh, Materials(Material{1e5, 0.3, 1000}));
     scene.solver.cg_fixed_iterations = 20;
-    Simulator<double> sim(std::move(scene), tracer, parallel_operator_factory<double>(tracer, Variant::Auto));
+    Simulator<double> sim(std::move(scene), tracer, cpu_operator_factory<double>({tracer, Variant::Auto}));
     for (int i = 0; i < 20; ++i) sim.step();
     tracer->sites = true;
     const double t0 = now_ns();

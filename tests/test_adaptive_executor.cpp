@@ -16,7 +16,7 @@
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "cpu/cpu_operator.hpp"
 #include "cantilever.hpp"
 #include "test_threads.hpp"
 
@@ -223,8 +223,8 @@ TEST(AdaptiveExecutor, SimulatorStepsBitwiseUnchanged) {
             for (int t : {2, 3}) {
                 const auto plain = make_executor(Backend::OpenMP, t);
                 const auto adaptive = std::make_shared<AdaptiveExecutor>(plain, 1);
-                Simulator<double> a(scene, plain, parallel_operator_factory<double>(plain, var));
-                Simulator<double> b(scene, adaptive, parallel_operator_factory<double>(adaptive, var));
+                Simulator<double> a(scene, plain, cpu_operator_factory<double>({plain, var}));
+                Simulator<double> b(scene, adaptive, cpu_operator_factory<double>({adaptive, var}));
                 for (int k = 0; k < 6; ++k) {
                     a.step();
                     b.step();

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "edgefem/parallel/cpu_backend.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/async_tangent.hpp"
@@ -38,7 +39,8 @@ double max_abs(std::span<const double> a) {
 }  // namespace
 
 TEST(AsyncTangent, FirstStepIsTheSynchronousStep) {
-    Simulator<double> sync(cantilever());
+    // The same operators as async_tangent_factory's default inner ones.
+    Simulator<double> sync(cantilever(), nullptr, cpu_operator_factory<double>());
     Simulator<double> async(cantilever(), nullptr, async_tangent_factory<double>());
     sync.step();
     async.step();

@@ -2,7 +2,7 @@
 // lumped mass, Lamé constants, and parameter validation.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "models.hpp"

@@ -3,7 +3,7 @@
 // differences), and the invariances of an elastic energy.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"

@@ -3,7 +3,7 @@
 // test mesh, at rest, twisted+stretched, rigidly rotated and perturbed.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
 

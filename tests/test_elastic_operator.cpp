@@ -10,7 +10,8 @@
 #include <limits>
 #include <vector>
 
-#include "edgefem/core/deformations.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
@@ -40,7 +41,7 @@ Mesh tiled_box() {
 
 void check_contract(const Mesh& mesh, bool expect_ring) {
     const Materials mat(Material{1e5, 0.3, 1000});
-    auto op = make_elastic_operator<double>(mesh, mat, ModelKind::FE, Method::Edge);
+    auto op = make_cpu_operator<double>(mesh, mat, ModelKind::FE, Method::Edge);
     const std::vector<double> u = deformation_displacement(mesh, Deformation::Twist);
     const std::vector<double> w = deformation_displacement(mesh, Deformation::Random);
     std::vector<double> x(u.size());
@@ -120,7 +121,7 @@ TEST(ElasticOperator, ExplicitStepsOnTheRingMatchStepsWithTheState) {
     const KeepStateSpy* spy[2] = {nullptr, nullptr};
     auto factory = [&spy](int i) -> OperatorFactory<double> {
         return [&spy, i](const Mesh& m, const Materials& mat, ModelKind k, Method me) {
-            auto op = std::make_unique<KeepStateSpy>(make_elastic_operator<double>(m, mat, k, me), i == 0);
+            auto op = std::make_unique<KeepStateSpy>(make_cpu_operator<double>(m, mat, k, me), i == 0);
             spy[i] = op.get();
             return std::unique_ptr<ElasticOperator<double>>(std::move(op));
         };

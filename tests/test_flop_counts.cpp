@@ -11,7 +11,7 @@
 #include "../bench/counting_scalar.hpp"
 #include "../bench/flop_counts.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "test_meshes.hpp"
 

@@ -5,8 +5,8 @@
 // mesh under a twist and a random configuration.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/layout_kernels.hpp"
+#include "lab/deformations.hpp"
+#include "lab/layout_kernels.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
 

@@ -11,9 +11,9 @@
 
 #include "edgefem/core/cg.hpp"
 #include "edgefem/core/error.hpp"
-#include "edgefem/parallel/barrier_latency.hpp"
+#include "lab/barrier_latency.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/variant.hpp"
+#include "cpu/variant.hpp"
 #include "test_threads.hpp"
 
 using namespace edgefem;

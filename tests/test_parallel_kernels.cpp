@@ -11,11 +11,11 @@
 #include <cstring>
 #include <random>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_edge_kernels.hpp"
-#include "edgefem/parallel/parallel_tet_kernels.hpp"
+#include "cpu/parallel_edge_kernels.hpp"
+#include "cpu/parallel_tet_kernels.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
 #include "test_threads.hpp"

@@ -11,7 +11,7 @@
 #include "edgefem/core/inverted_tets.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "cpu/cpu_operator.hpp"
 #include "cantilever.hpp"
 #include "models.hpp"
 #include "test_threads.hpp"
@@ -60,14 +60,14 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
         EXPECT_GT(edgefem::test::max_abs(core.u), 0);
         for (Variant var : kAllVariants) {
             const auto serial_ex = std::make_shared<SerialExecutor>();
-            const Result serial = run(method, serial_ex, parallel_operator_factory<double>(serial_ex, var));
+            const Result serial = run(method, serial_ex, cpu_operator_factory<double>({serial_ex, var}));
             const std::string tag = std::string(method == Method::Edge ? "edge/" : "tet/") + to_string(var);
             EXPECT_LE(rel_diff(serial.u, core.u), 1e-12) << tag;
             EXPECT_LE(rel_diff(serial.v, core.v), 1e-12) << tag;
             for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
                 for (int t : edgefem::test::test_thread_counts()) {
                     const auto ex = make_executor(b, t);
-                    const Result par = run(method, ex, parallel_operator_factory<double>(ex, var));
+                    const Result par = run(method, ex, cpu_operator_factory<double>({ex, var}));
                     const std::string where = tag + "/" + to_string(b) + "-" + std::to_string(t);
                     if (is_deterministic(var) || (method == Method::Tet && var != Variant::Private)) {
                         EXPECT_TRUE(same(par.u, serial.u)) << where << " " << rel_diff(par.u, serial.u);
@@ -140,12 +140,12 @@ TEST(ParallelSimulator, ImplicitAndStaticDeterministic) {
     EXPECT_GT(edgefem::test::max_abs(core), 0);
     for (Variant var : {Variant::Auto, Variant::Gather, Variant::Colour}) {
         const auto serial_ex = std::make_shared<SerialExecutor>();
-        const std::vector<double> serial = run_both(serial_ex, parallel_operator_factory<double>(serial_ex, var));
+        const std::vector<double> serial = run_both(serial_ex, cpu_operator_factory<double>({serial_ex, var}));
         EXPECT_LE(rel_diff(serial, core), 1e-9) << to_string(var);
         for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
             for (int t : edgefem::test::test_thread_counts()) {
                 const auto ex = make_executor(b, t);
-                EXPECT_TRUE(same(run_both(ex, parallel_operator_factory<double>(ex, var)), serial))
+                EXPECT_TRUE(same(run_both(ex, cpu_operator_factory<double>({ex, var})), serial))
                     << to_string(var) << "/" << to_string(b) << "-" << t;
             }
     }

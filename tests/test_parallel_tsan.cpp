@@ -10,14 +10,14 @@
 #include <cstring>
 #include <thread>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_edge_kernels.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
-#include "edgefem/parallel/parallel_tet_kernels.hpp"
+#include "cpu/parallel_edge_kernels.hpp"
+#include "cpu/cpu_operator.hpp"
+#include "cpu/parallel_tet_kernels.hpp"
 #include "cantilever.hpp"
 #include "models.hpp"
 
@@ -99,7 +99,7 @@ TEST(ParallelTsan, TetKernelsAndStep) {
             std::vector<std::vector<double>> u;
             for (int threads : {1, 3}) {
                 const auto ex = std::make_shared<ThreadExecutor>(threads);
-                Simulator<double> sim(s, ex, parallel_operator_factory<double>(ex, v));
+                Simulator<double> sim(s, ex, cpu_operator_factory<double>({ex, v}));
                 sim.step();
                 sim.step();
                 u.emplace_back(sim.displacement().begin(), sim.displacement().end());
@@ -120,8 +120,8 @@ TEST(ParallelTsan, AdaptiveExecutor) {
     s.dt = 2e-3;
     const auto plain = std::make_shared<ThreadExecutor>(3);
     const auto adaptive = std::make_shared<AdaptiveExecutor>(plain, 1);
-    Simulator<double> a(s, plain, parallel_operator_factory<double>(plain, Variant::Auto));
-    Simulator<double> b(s, adaptive, parallel_operator_factory<double>(adaptive, Variant::Auto));
+    Simulator<double> a(s, plain, cpu_operator_factory<double>({plain, Variant::Auto}));
+    Simulator<double> b(s, adaptive, cpu_operator_factory<double>({adaptive, Variant::Auto}));
     for (int k = 0; k < 4; ++k) {
         a.step();
         b.step();
@@ -151,7 +151,7 @@ TEST(ParallelTsan, PoolExecutor) {
         for (int threads : {1, 3}) {
             for (Schedule sched : {Schedule::Dynamic, Schedule::Static}) {
                 const auto ex = make_executor(Backend::Pool, threads, sched);
-                Simulator<double> sim(s, ex, parallel_operator_factory<double>(ex, v));
+                Simulator<double> sim(s, ex, cpu_operator_factory<double>({ex, v}));
                 sim.step();
                 sim.step();
                 u.emplace_back(sim.displacement().begin(), sim.displacement().end());
@@ -178,9 +178,9 @@ TEST(ParallelTsan, PoolNewton) {
         s.dt = 2e-3;
         s.rayleigh_alpha = 0.5;
         s.rayleigh_beta = 1e-3;
-        Simulator<double> sim(s, ex, parallel_operator_factory<double>(ex, Variant::Auto));
+        Simulator<double> sim(s, ex, cpu_operator_factory<double>({ex, Variant::Auto}));
         sim.step();
-        Simulator<double> st(edgefem::test::clamped_box_scene(5, 2, 2), ex, parallel_operator_factory<double>(ex, Variant::Auto));
+        Simulator<double> st(edgefem::test::clamped_box_scene(5, 2, 2), ex, cpu_operator_factory<double>({ex, Variant::Auto}));
         EXPECT_TRUE(st.solve_static().converged);
         std::vector<double> u(sim.displacement().begin(), sim.displacement().end());
         u.insert(u.end(), st.displacement().begin(), st.displacement().end());

@@ -12,12 +12,12 @@
 
 #include <cstring>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_edge_kernels.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "cpu/parallel_edge_kernels.hpp"
+#include "cpu/cpu_operator.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 #include "models.hpp"
@@ -313,13 +313,12 @@ TEST(PartitionColouring, ParallelOperatorTakesPartUnitsThroughPlanOptions) {
     const Material mat{1e5, 0.3, 1000};
     const auto u = deformation_displacement(pm.mesh, Deformation::Twist);
     std::vector<double> f_ref(u.size()), f(u.size()), y_ref(u.size()), y(u.size());
-    auto ref = make_elastic_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge);
+    auto ref = make_cpu_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge);
     ref->forces(u.data(), f_ref.data(), false);
     ref->build_stiffness(false);
     ref->multiply(u.data(), y_ref.data());
     for (int threads : {1, 2}) {
-        auto op = make_parallel_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge,
-                                                 make_executor(Backend::OpenMP, threads), Variant::Colour, opts);
+        auto op = make_cpu_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(Backend::OpenMP, threads), Variant::Colour}, opts);
         op->forces(u.data(), f.data(), false);
         op->build_stiffness(false);
         op->multiply(u.data(), y.data());
@@ -329,7 +328,6 @@ TEST(PartitionColouring, ParallelOperatorTakesPartUnitsThroughPlanOptions) {
     // Parts of another mesh do not fit: rejected when the plan is built.
     PlanOptions wrong = opts;
     wrong.vertex_colouring.unit_first.back() += 1;
-    EXPECT_THROW(make_parallel_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge,
-                                                make_executor(Backend::OpenMP, 1), Variant::Colour, wrong),
+    EXPECT_THROW(make_cpu_operator<double>(pm.mesh, mat, ModelKind::FE, Method::Edge, CpuOptions{make_executor(Backend::OpenMP, 1), Variant::Colour}, wrong),
                  InvalidArgument);
 }

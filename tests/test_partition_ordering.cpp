@@ -2,7 +2,7 @@
 // summation order, and the locality orderings actually improve locality.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"

@@ -1,7 +1,7 @@
 // The README's code examples, kept compiling and running.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/edge_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"

@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "edgefem/parallel/cpu_backend.hpp"
 #include "edgefem/core/cg.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/make_box.hpp"
@@ -171,7 +172,7 @@ TEST(Simulator, StaticEquilibriumResidualAndReactionsEqualWeight) {
 
 TEST(Simulator, DefiniteTangentKeepsCgConvergentOnCompressedCube) {
     const Mesh mesh = make_box(4, 4, 4);
-    auto plain = make_elastic_operator<double>(mesh, Material{1e5, 0.3, 1000}, ModelKind::FE, Method::Edge);
+    auto plain = make_cpu_operator<double>(mesh, Material{1e5, 0.3, 1000}, ModelKind::FE, Method::Edge);
     // Compress to 20% of the height, with a small shear so the state is generic.
     std::vector<double> u(mesh.X.size());
     for (index_t v = 0; v < mesh.num_vertices(); ++v) {
@@ -315,7 +316,7 @@ private:
 
 OperatorFactory<double> counting_factory(int& builds) {
     return [&builds](const Mesh& m, const Materials& mat, ModelKind k, Method me) -> std::unique_ptr<ElasticOperator<double>> {
-        return std::make_unique<CountingOperator>(make_elastic_operator<double>(m, mat, k, me), builds);
+        return std::make_unique<CountingOperator>(make_cpu_operator<double>(m, mat, k, me), builds);
     };
 }
 
@@ -528,7 +529,7 @@ private:
 
 OperatorFactory<double> jitter_factory(double jitter) {
     return [jitter](const Mesh& m, const Materials& mat, ModelKind k, Method me) -> std::unique_ptr<ElasticOperator<double>> {
-        return std::make_unique<JitterOperator>(make_elastic_operator<double>(m, mat, k, me), jitter);
+        return std::make_unique<JitterOperator>(make_cpu_operator<double>(m, mat, k, me), jitter);
     };
 }
 

@@ -2,7 +2,7 @@
 // and a different material from FE.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"

@@ -9,14 +9,14 @@
 #include <vector>
 
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "cpu/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/stream_bandwidth.hpp"
+#include "lab/stream_bandwidth.hpp"
 
 using namespace edgefem;
 

@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "edgefem/core/stress_suite.hpp"
+#include "lab/stress_suite.hpp"
 
 using namespace edgefem;
 

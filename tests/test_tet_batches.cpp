@@ -3,7 +3,7 @@
 // against the one-tet kernels they replace for built-in scalars.
 #include <gtest/gtest.h>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
 
@@ -13,7 +13,7 @@ using test::rel_diff;
 namespace {
 
 template <class S>
-void check_layout(const TetModel<S>& m, const std::string& name) {
+void check_layout(const BatchedTetModel<S>& m, const std::string& name) {
     ASSERT_EQ(index_t(m.batches.size()), m.num_batches()) << name;
     std::vector<int> seen(m.num_tets(), 0);
     for (index_t b = 0; b < m.num_batches(); ++b)
@@ -35,7 +35,7 @@ void check_layout(const TetModel<S>& m, const std::string& name) {
 // The batched serial loops against kernel::tet_force / tet_stiffness per tet.
 template <class S>
 void check_against_per_tet(const test::NamedMesh& nm, double tol) {
-    const TetModel<S> m = make_tet_model<S>(nm.mesh, Material{1e5, 0.3, 1000});
+    const BatchedTetModel<S> m = make_batched_tet_model<S>(nm.mesh, Material{1e5, 0.3, 1000});
     check_layout(m, nm.name);
     const auto u = test::cast<S>(deformation_displacement(nm.mesh, Deformation::Twist));
     std::vector<S> f(u.size()), f0(u.size(), S(0));

@@ -8,10 +8,10 @@
 #include <numeric>
 #include <random>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "cpu/tet_edge_form.hpp"
 #include "models.hpp"
 #include "test_meshes.hpp"
 

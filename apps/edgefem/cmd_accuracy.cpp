@@ -33,9 +33,10 @@
 #include <memory>
 #include <sstream>
 
+#include "edgefem/parallel/cpu_backend.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
-#include "edgefem/core/named_mesh.hpp"
+#include "lab/named_mesh.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "option_checks.hpp"
@@ -260,7 +261,7 @@ Trajectory simulate(const AccScene& sc, const Config& c) {
     Trajectory tr;
     const auto t0 = Clock::now();
     try {
-        Simulator<S> sim(configured(sc, c));
+        Simulator<S> sim(configured(sc, c), nullptr, cpu_operator_factory<S>());
         if (!sc.u0.empty()) std::copy(sc.u0.begin(), sc.u0.end(), sim.displacement().begin());
         tr.energy.push_back(sim.energies());
         const long total = std::lround(sc.duration / c.dt);

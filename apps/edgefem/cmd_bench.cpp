@@ -14,16 +14,16 @@
 #include "common.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"
 #include "timing.hpp"
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/deformations.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "lab/deformations.hpp"
+#include "cpu/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
-#include "edgefem/parallel/barrier_latency.hpp"
-#include "edgefem/parallel/stream_bandwidth.hpp"
+#include "cpu/cpu_operator.hpp"
+#include "lab/barrier_latency.hpp"
+#include "lab/stream_bandwidth.hpp"
 
 namespace edgefem::cli {
 

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "common.hpp"
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/simulator.hpp"
 
 namespace edgefem::cli {

@@ -8,7 +8,7 @@
 
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/simulator.hpp"
-#include "edgefem/core/stress_suite.hpp"
+#include "lab/stress_suite.hpp"
 #include "option_checks.hpp"
 #include "evidence_commands.hpp"
 

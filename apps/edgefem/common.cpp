@@ -10,12 +10,12 @@
 #include <sstream>
 
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
-#include "edgefem/core/tet_kernels.hpp"
+#include "cpu/tet_kernels.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/executors.hpp"

@@ -18,6 +18,7 @@
 #include "edgefem/core/mesh.hpp"
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/validate_mesh.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
 #include "option_checks.hpp"
 
 namespace edgefem::cli {

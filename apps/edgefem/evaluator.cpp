@@ -6,7 +6,7 @@
 #include "timing.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "cpu/cpu_operator.hpp"
 
 namespace edgefem::cli {
 
@@ -66,10 +66,8 @@ private:
 template <class S>
 std::unique_ptr<Evaluator> make_evaluator_as(const Mesh& mesh, const ModelOptions& opts, const ExecOptions& exec) {
     const edgefem::Method method = opts.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
-    OperatorFactory<S> factory = operator_factory<S>(exec, exec.executor(), opts.layout_kind());
-    auto op = factory ? factory(mesh, opts.material, opts.kind(), method)
-                      : make_elastic_operator<S>(mesh, opts.material, opts.kind(), method, opts.layout_kind());
-    return std::make_unique<OperatorEvaluator<S>>(std::move(op));
+    const OperatorFactory<S> factory = operator_factory<S>(exec, exec.executor(), opts.layout_kind());
+    return std::make_unique<OperatorEvaluator<S>>(factory(mesh, opts.material, opts.kind(), method));
 }
 
 }  // namespace
@@ -82,15 +80,8 @@ std::unique_ptr<Evaluator> make_evaluator(const Mesh& mesh, const ModelOptions& 
 template <class S>
 OperatorFactory<S> operator_factory(const ExecOptions& exec, const std::shared_ptr<const Executor>& executor,
                                     StiffnessLayout layout) {
-    if (!exec.parallel_kernels()) {
-        if (layout == StiffnessLayout::TetLocal) return {};
-        return [layout](const Mesh& mesh, const Materials& materials, ModelKind model, edgefem::Method method) {
-            return make_elastic_operator<S>(mesh, materials, model, method, layout);
-        };
-    }
-    PlanOptions plan;
-    plan.stiffness_layout = layout;
-    return parallel_operator_factory<S>(executor, parse_variant(exec.variant), plan);
+    // The serial loops unless a threaded back-end or a variant is asked for.
+    return cpu_operator_factory<S>({exec.parallel_kernels() ? executor : nullptr, parse_variant(exec.variant), layout});
 }
 
 template OperatorFactory<double> operator_factory<double>(const ExecOptions&, const std::shared_ptr<const Executor>&,

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "edgefem/core/tet_kernels.hpp"
+#include "cpu/tet_kernels.hpp"
 #include "edgefem/core/write_vtu.hpp"
 
 namespace edgefem::cli {

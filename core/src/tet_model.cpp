@@ -1,7 +1,5 @@
 #include "edgefem/core/tet_model.hpp"
 
-#include <type_traits>
-
 #include "edgefem/core/coefficients.hpp"
 
 namespace edgefem {
@@ -24,21 +22,6 @@ TetModel<S> make_tet_model(const Mesh& mesh, const Materials& materials) {
         m.data[t].vol_lambda = static_cast<S>(g.volume * mat.lambda());
         m.data[t].vol_mu = static_cast<S>(g.volume * mat.mu());
         m.volume[t] = g.volume;
-    }
-    if constexpr (std::is_floating_point_v<S>) {
-        m.batches.resize(m.num_batches());
-        for (index_t b = 0; b < m.num_batches(); ++b) {
-            TetBatch<S>& bt = m.batches[b];
-            for (int l = 0; l < kTetBatchLanes; ++l) {
-                const index_t t = m.batch_tet(b, l);
-                const TetData<S> d = t < nt ? m.data[t] : TetData<S>{};
-                for (int i = 0; i < 4; ++i) bt.v[i][l] = t < nt ? m.tet[t][i] : 0;
-                for (int i = 0; i < 3; ++i)
-                    for (int c = 0; c < 3; ++c) bt.Dinv[i][c][l] = d.Dinv[i][c];
-                bt.vol_lambda[l] = d.vol_lambda;
-                bt.vol_mu[l] = d.vol_mu;
-            }
-        }
     }
     return m;
 }

@@ -30,7 +30,7 @@
 #ifdef EDGEFEM_HAPTIC_HAVE_PARALLEL
 #include "edgefem/parallel/executors.hpp"
 #include "edgefem/parallel/async_tangent.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
 #endif
 #ifdef EDGEFEM_HAPTIC_HAVE_PARTITION
 #include "edgefem/partition/ordering.hpp"
@@ -268,13 +268,14 @@ int run(const Options& o) {
     scene.count_inverted_tets = false;  // a statistic the loop does not need
 
     std::shared_ptr<const Executor> executor;
-    OperatorFactory<S> factory;
+    OperatorFactory<S> factory;  // empty: the reference back-end
     std::string backend = "serial";
     int threads = 1;
 #ifdef EDGEFEM_HAPTIC_HAVE_PARALLEL
+    factory = cpu_operator_factory<S>();  // the CPU back-end's serial loops
     if (o.backend != "serial") {
         executor = make_executor(parse_backend(o.backend), o.threads);
-        factory = parallel_operator_factory<S>(executor, parse_variant(o.variant));
+        factory = cpu_operator_factory<S>({executor, parse_variant(o.variant)});
         backend = executor->name();
         threads = executor->threads();
     }

@@ -1,5 +1,7 @@
 #include "edgefem/parallel/async_tangent.hpp"
 
+#include "edgefem/parallel/cpu_backend.hpp"
+
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -124,7 +126,7 @@ template <class S>
 OperatorFactory<S> async_tangent_factory(OperatorFactory<S> inner) {
     if (!inner)
         inner = [](const Mesh& m, const Materials& mat, ModelKind k, Method me) {
-            return make_elastic_operator<S>(m, mat, k, me);
+            return make_cpu_operator<S>(m, mat, k, me);
         };
     return [inner](const Mesh& m, const Materials& mat, ModelKind k, Method me) -> std::unique_ptr<ElasticOperator<S>> {
         return std::make_unique<AsyncTangentOperator<S>>(inner(m, mat, k, me), inner(m, mat, k, me), inner(m, mat, k, me));

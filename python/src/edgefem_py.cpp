@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
@@ -25,7 +25,7 @@
 #ifdef EDGEFEM_PY_HAVE_PARALLEL
 #include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/parallel_operator.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
 #endif
 
 namespace py = pybind11;
@@ -84,7 +84,7 @@ Mesh mesh_from_arrays(const InArray& X, const InIndex& tets, std::optional<std::
 // keeps a reference to it).
 struct ElasticModel {
     ElasticModel(Mesh m, const Materials& mat, ModelKind kind, Method method)
-        : mesh(std::move(m)), op(make_elastic_operator<double>(mesh, mat, kind, method)) {}
+        : mesh(std::move(m)), op(make_cpu_operator<double>(mesh, mat, kind, method)) {}
     ElasticModel(const ElasticModel&) = delete;
     ElasticModel& operator=(const ElasticModel&) = delete;
     std::size_t dofs() const { return 3 * std::size_t(mesh.num_vertices()); }
@@ -127,11 +127,11 @@ double median(const std::vector<double>& v) {
 
 std::unique_ptr<Simulator<double>> make_simulator(Scene scene, const std::string& backend, int threads,
                                                   bool adaptive) {
-    if (backend == "serial") return std::make_unique<Simulator<double>>(std::move(scene));
+    if (backend == "serial") return std::make_unique<Simulator<double>>(std::move(scene), nullptr, cpu_operator_factory<double>());
 #ifdef EDGEFEM_PY_HAVE_PARALLEL
     auto ex = make_executor(parse_backend(backend), threads);
     if (adaptive) ex = make_adaptive(std::move(ex));
-    return std::make_unique<Simulator<double>>(std::move(scene), ex, parallel_operator_factory<double>(ex));
+    return std::make_unique<Simulator<double>>(std::move(scene), ex, cpu_operator_factory<double>({ex}));
 #else
     (void)threads;
     (void)adaptive;

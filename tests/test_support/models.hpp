@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/edge_kernels.hpp"
-#include "edgefem/core/tet_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
+#include "cpu/tet_kernels.hpp"
 #include "edgefem/core/topology.hpp"
 
 namespace edgefem::test {
@@ -18,7 +18,7 @@ struct Models {
     Topology topo;
     Coefficients coef;
     EdgeModel<S> edge;
-    TetModel<S> tet;
+    BatchedTetModel<S> tet;
 };
 
 template <class S>
@@ -27,7 +27,7 @@ Models<S> make_models(const Mesh& mesh, const Materials& mat = Material{1e5, 0.3
     m.topo = build_topology(mesh);
     m.coef = compute_coefficients(mesh, m.topo, mat);
     m.edge = make_edge_model<S>(m.topo, m.coef);
-    m.tet = make_tet_model<S>(mesh, mat);
+    m.tet = make_batched_tet_model<S>(mesh, mat);
     return m;
 }
 

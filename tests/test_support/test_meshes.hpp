@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "edgefem/core/mesh.hpp"
-#include "edgefem/core/named_mesh.hpp"
+#include "lab/named_mesh.hpp"
 
 namespace edgefem::test {
 

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "edgefem/core/topology.hpp"
-#include "edgefem/parallel/colouring.hpp"
+#include "cpu/colouring.hpp"
 
 namespace edgefem::test {
 

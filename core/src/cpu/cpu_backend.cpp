@@ -3,6 +3,7 @@
 // one parallel region of three phases per iteration).
 #include "cpu/blocked_launch.hpp"
 #include "edgefem/core/backend.hpp"
+#include "edgefem/core/reference_operator.hpp"
 #include "unified/unified_vector_kernels.hpp"
 
 namespace edgefem {
@@ -34,7 +35,7 @@ public:
     std::unique_ptr<ElasticOperator<S>> make_operator(const Mesh& mesh, const Materials& materials, ModelKind model,
                                                       Method method) const override {
         if (factory_) return factory_(mesh, materials, model, method);
-        return make_elastic_operator<S>(mesh, materials, model, method);
+        return make_reference_operator<S>(mesh, materials, model, method);
     }
     const VectorKernels<S>& kernels() const override { return kernels_; }
     const VectorMemory& memory() const override { return host_memory(); }

@@ -1,7 +1,8 @@
 // The reference back-end: host memory, the unified vector kernels as plain
 // serial loops in index order, CG as plain passes (plain_cg.hpp), and
-// core's serial operator.
+// the reference operator.
 #include "edgefem/core/backend.hpp"
+#include "edgefem/core/reference_operator.hpp"
 #include "reference/plain_cg.hpp"
 #include "reference/serial_launch.hpp"
 #include "unified/unified_vector_kernels.hpp"
@@ -27,7 +28,7 @@ public:
     int threads() const override { return 1; }
     std::unique_ptr<ElasticOperator<S>> make_operator(const Mesh& mesh, const Materials& materials, ModelKind model,
                                                       Method method) const override {
-        return make_elastic_operator<S>(mesh, materials, model, method);
+        return make_reference_operator<S>(mesh, materials, model, method);
     }
     const VectorKernels<S>& kernels() const override { return kernels_; }
     const VectorMemory& memory() const override { return host_memory(); }

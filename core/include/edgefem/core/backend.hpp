@@ -2,8 +2,10 @@
 // memory its vectors live in and runs the vector kernels
 // (vector_kernels.hpp) on them. Core provides two: the reference back-end
 // (plain serial loops in index order, the oracle of the tests) and the CPU
-// back-end (fixed blocks on an Executor: serial, or parallel/'s OpenMP, TBB
-// and pool executors; bitwise the same for any thread count).
+// back-end's vector kernels (fixed blocks on an Executor: serial, or
+// parallel/'s OpenMP, TBB and pool executors; bitwise the same for any
+// thread count) with an operator factory (parallel/'s tuned CPU operators,
+// or the reference operator).
 #pragma once
 
 #include <functional>
@@ -16,9 +18,10 @@
 
 namespace edgefem {
 
-// Builds the elastic model a simulator uses; parallel/ provides factories
-// that run the kernels on OpenMP or TBB. The default is make_elastic_operator
-// (serial).
+// Builds the elastic model a simulator uses: a back-end's operator
+// (cpu_operator_factory in edgefem/parallel/cpu_backend.hpp for the CPU
+// back-end's). The default is the reference back-end's
+// (make_reference_operator: plain serial loops).
 template <class S>
 using OperatorFactory =
     std::function<std::unique_ptr<ElasticOperator<S>>(const Mesh&, const Materials&, ModelKind, Method)>;
@@ -42,14 +45,16 @@ public:
     }
 };
 
-// Plain serial loops in index order and core's serial operator
-// (make_elastic_operator): slow, simple, the reference results.
+// Plain serial loops in index order, for the vectors and the operator
+// (make_reference_operator): slow, simple, the reference results.
 template <class S>
 std::shared_ptr<const ComputeBackend<S>> make_reference_backend();
 
 // Vector kernels in fixed blocks on `executor` (serial when null), the
-// results the same for any thread count; operators from `factory` (core's
-// serial operator when empty). What Simulator(scene) runs on.
+// results the same for any thread count; operators from `factory` (the
+// reference operator when empty; cpu_operator_factory in
+// edgefem/parallel/cpu_backend.hpp for the tuned ones). What
+// Simulator(scene) runs on.
 template <class S>
 std::shared_ptr<const ComputeBackend<S>> make_cpu_backend(std::shared_ptr<const Executor> executor = nullptr,
                                                           OperatorFactory<S> factory = {});

@@ -1,7 +1,10 @@
-// One interface over the elastic models a simulation can use — edge-based FE,
-// edge-based SN, or the per-tet method — so the integrators never know which
-// runs. Each virtual call is a whole-mesh kernel; the FE/SN and
-// definite/plain choices are template parameters inside.
+// The elastic model's kernels, declared once: forces (and the energy),
+// the tangent stiffness K, K x, K's diagonal blocks, for the edge-based FE,
+// the edge-based SN or the per-tet method. Every back-end implements them
+// (the reference back-end: core/src/reference/, plain loops over the
+// formulas of edgefem/physics/; the CPU back-end: parallel/src/cpu/, lanes,
+// tiles and threads), so the integrators and solvers never know which runs.
+// Each virtual call is a whole-mesh kernel.
 #pragma once
 
 #include <memory>
@@ -15,17 +18,6 @@
 namespace edgefem {
 
 enum class Method { Edge, Tet };
-
-// Where the edge method's FE stiffness takes its pair terms from: the
-// per-tet 6x6 form (tet_edge_form.hpp; 2-3x faster, measured in
-// docs/layouts.md) or the mesh-wide TSEP list with its 4 targets per pair.
-// With the tet-local form, core's serial forces (and the parallel owner
-// variant's) take g from the form too; the other parallel variants run the
-// TSEP list for the forces. SN and the per-tet method ignore it.
-enum class StiffnessLayout { TetLocal, TsepList };
-// "tet-local" | "tsep-list"; throws InvalidArgument otherwise.
-StiffnessLayout parse_stiffness_layout(const std::string& name);
-const char* to_string(StiffnessLayout layout);
 
 template <class S>
 class ElasticOperator {
@@ -67,11 +59,5 @@ public:
     // (stream_bandwidth.hpp counts those bytes only then).
     virtual bool forces_stored_state() const { return true; }
 };
-
-// Throws InvalidArgument for SN with the per-tet method.
-template <class S>
-std::unique_ptr<ElasticOperator<S>> make_elastic_operator(const Mesh& mesh, const Materials& materials,
-                                                          ModelKind model, Method method,
-                                                          StiffnessLayout layout = StiffnessLayout::TetLocal);
 
 }  // namespace edgefem

@@ -65,8 +65,8 @@ public:
     // Validates the scene (InvalidArgument naming the field) and sets up the
     // model; the state starts at rest (u = 0, v = 0). `executor` runs the
     // solver's vector operations (serial when null); `factory` builds the
-    // elastic model (serial kernels when empty): make_cpu_backend(executor,
-    // factory).
+    // elastic model (the reference back-end's operator when empty):
+    // make_cpu_backend(executor, factory).
     explicit Simulator(Scene scene, std::shared_ptr<const Executor> executor = nullptr,
                        OperatorFactory<S> factory = {});
     // The same on `backend` (the CPU back-end on one thread when null): the

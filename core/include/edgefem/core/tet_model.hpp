@@ -3,7 +3,6 @@
 #pragma once
 
 #include <array>
-#include <type_traits>
 #include <vector>
 
 #include "edgefem/core/material.hpp"
@@ -21,66 +20,15 @@ struct TetData {
     S vol_mu;
 };
 
-// Tets per batch of the lane-batched loops, and the batches per group whose
-// lanes are interleaved (see TetModel::batch_tet).
-inline constexpr int kTetBatchLanes = 4;
-inline constexpr index_t kTetBatchInterleave = 16;
-
-// One lane value per tet of a batch: a 4-lane GCC/Clang vector for built-in
-// scalars (a class template: the attribute on a dependent typedef is ignored
-// inside function templates); other scalars are never batched.
-template <class S, bool = std::is_floating_point_v<S>>
-struct TetLanes {
-    typedef S V __attribute__((vector_size(kTetBatchLanes * sizeof(S))));
-};
-template <class S>
-struct TetLanes<S, false> {
-    using V = std::array<S, kTetBatchLanes>;
-};
-
-// TetData and the vertex ids of 4 tets, structure-of-arrays, so that the
-// per-tet arithmetic runs across the tets in SIMD lanes. Padding lanes (past
-// the last tet) hold zero data and vertex 0: they add exactly zero to
-// vertex 0 and read and write nothing out of bounds.
-template <class S>
-struct TetBatch {
-    using V = typename TetLanes<S>::V;
-    V Dinv[3][3];
-    V vol_lambda;
-    V vol_mu;
-    index_t v[4][kTetBatchLanes];  // [local vertex][lane]
-};
-
 template <class S>
 struct TetModel {
     index_t num_vertices = 0;
     std::vector<std::array<index_t, 4>> tet;
     std::vector<TetData<S>> data;
     std::vector<double> volume;  // rest volumes (not read by the hot loops)
-    // The same tets in batches (built-in scalars only; empty otherwise): what
-    // the force and stiffness loops read.
-    std::vector<TetBatch<S>> batches;
-
     index_t num_tets() const { return static_cast<index_t>(tet.size()); }
-    index_t num_batches() const { return (num_tets() + kTetBatchLanes - 1) / kTetBatchLanes; }
-    // The tet in lane l of batch b (num_tets() or more: a padding lane).
-    // Groups of kTetBatchInterleave batches interleave their lanes: lane l of
-    // batch j of a group holds the group's tet l * kTetBatchInterleave + j,
-    // so the tets of one batch rarely share a vertex and their scatters do
-    // not chain through memory (bunny-4k and armadillo-7k, ns per tet: force
-    // 12.1-12.3 against 12.2-12.5 with consecutive tets, stiffness 38.7-39.5
-    // against 39-42). The last, incomplete group stays in plain order.
-    index_t batch_tet(index_t b, int l) const {
-        constexpr index_t group = kTetBatchInterleave * kTetBatchLanes;
-        if ((b / kTetBatchInterleave + 1) * group > num_tets()) return b * kTetBatchLanes + l;
-        return b / kTetBatchInterleave * group + l * kTetBatchInterleave + b % kTetBatchInterleave;
-    }
-    // Bytes of model data the force loop reads per tet: the batches' (as
-    // many as tet + data, padding aside: 104 in double, 60 in float).
-    double bytes_per_tet() const {
-        if (!batches.empty()) return double(sizeof(batches[0])) * num_batches() / num_tets();
-        return sizeof(tet[0]) + sizeof(data[0]);
-    }
+    // Bytes of model data per tet (vertex ids, Dm^-1, Vol lambda, Vol mu).
+    double bytes_per_tet() const { return sizeof(tet[0]) + sizeof(data[0]); }
 };
 
 // Per-tet stiffness: the 10 distinct 3x3 blocks K_ab, a <= b, in the order

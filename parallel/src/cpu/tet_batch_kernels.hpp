@@ -10,8 +10,8 @@
 #include <cstring>
 #include <type_traits>
 
-#include "edgefem/core/kernel_inline.hpp"
-#include "edgefem/core/tet_model.hpp"
+#include "cpu/kernel_inline.hpp"
+#include "cpu/tet_batches.hpp"
 #include "edgefem/physics/tet_stvk.hpp"
 
 namespace edgefem {
@@ -116,7 +116,7 @@ EDGEFEM_KERNEL void batch_stiffness_terms(const TetBatch<S>& bt, const BatchDefo
 // (Recomputed from u: handing it the terms kept them in memory on the hot
 // path, 40 -> 44 ns per tet on bunny-4k.)
 template <class S>
-__attribute__((noinline, cold)) void batch_stiffness_padded(const TetModel<S>& m, index_t b, const S* __restrict u,
+__attribute__((noinline, cold)) void batch_stiffness_padded(const BatchedTetModel<S>& m, index_t b, const S* __restrict u,
                                                             S* __restrict K) {
     BatchDeformation<S> d;
     batch_deformation<false>(m.batches[b], u, d);
@@ -136,7 +136,7 @@ __attribute__((noinline, cold)) void batch_stiffness_padded(const TetModel<S>& m
 // against 48 through a 90-vector buffer and 60 with the buffer stored lane
 // by lane; the batches' own layout (no transposes) would take 30.
 template <class S>
-EDGEFEM_KERNEL void batch_stiffness_store(const TetModel<S>& m, index_t b, const BatchStiffnessTerms<S>& k,
+EDGEFEM_KERNEL void batch_stiffness_store(const BatchedTetModel<S>& m, index_t b, const BatchStiffnessTerms<S>& k,
                                           S* __restrict K) {
     using V = typename TetBatch<S>::V;
     S* out[kTetBatchLanes];
@@ -152,7 +152,7 @@ EDGEFEM_KERNEL void batch_stiffness_store(const TetModel<S>& m, index_t b, const
 }
 
 template <class S>
-EDGEFEM_KERNEL void batch_stiffness(const TetModel<S>& m, index_t b, const S* __restrict u, S* __restrict K) {
+EDGEFEM_KERNEL void batch_stiffness(const BatchedTetModel<S>& m, index_t b, const S* __restrict u, S* __restrict K) {
     if ((b + 1) * kTetBatchLanes > m.num_tets()) return batch_stiffness_padded(m, b, u, K);
     BatchDeformation<S> d;
     batch_deformation<false>(m.batches[b], u, d);

@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "edgefem/core/coefficients.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh.hpp"

@@ -1,33 +1,15 @@
-// How a parallel kernel resolves concurrent writes to one target.
+// The threaded kernels' plans: colourings, owner parts, and the tuning
+// knobs behind CpuOptions (edgefem/parallel/cpu_backend.hpp).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <string_view>
 
-#include "edgefem/core/elastic_operator.hpp"
-#include "edgefem/parallel/colouring.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
+#include "cpu/colouring.hpp"
 
 namespace edgefem {
-
-enum class Variant {
-    Colour,   // coloured scatter: colours in a fixed order, plain stores (deterministic)
-    Gather,   // pull: each target sums its sources via CSR lists (deterministic)
-    Atomic,   // scatter with std::atomic_ref fetch_add (order varies run to run)
-    Private,  // one accumulator per thread part, then a parallel blocked reduction
-    Owner,    // owner computes: fixed parts of consecutive items, forward spill + ordered reduction (deterministic)
-    Auto,     // the default: Owner when the vertex numbering has locality (spill windows <= the vertices), else Gather
-};
-inline constexpr Variant kAllVariants[] = {Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private,
-                                           Variant::Owner};
-
-// "colour" (or "color") | "gather" | "atomic" | "private" | "owner" | "auto"; throws InvalidArgument.
-Variant parse_variant(std::string_view name);
-const char* to_string(Variant v);
-// True for the variants whose results are bitwise independent of the thread count.
-inline bool is_deterministic(Variant v) {
-    return v == Variant::Colour || v == Variant::Gather || v == Variant::Owner || v == Variant::Auto;
-}
 
 // Blocks of consecutive items coloured as units: with a locality ordering a
 // block is spatially compact, so each thread streams through contiguous

@@ -1,4 +1,4 @@
-#include "edgefem/parallel/barrier_latency.hpp"
+#include "lab/barrier_latency.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -21,7 +21,7 @@
 
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/executor.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
+#include "cpu/tet_edge_form.hpp"
 
 namespace edgefem {
 

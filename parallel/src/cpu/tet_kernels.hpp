@@ -8,10 +8,10 @@
 #include <type_traits>
 #include <vector>
 
-#include "edgefem/core/kernel_inline.hpp"
-#include "edgefem/core/tet_batch_kernels.hpp"
+#include "cpu/kernel_inline.hpp"
+#include "cpu/tet_batch_kernels.hpp"
 #include "edgefem/core/tet_model.hpp"
-#include "edgefem/core/xyz4.hpp"
+#include "cpu/xyz4.hpp"
 #include "edgefem/physics/edge_blocks.hpp"
 #include "edgefem/physics/tet_stvk.hpp"
 
@@ -133,10 +133,10 @@ EDGEFEM_KERNEL void tet_kx_matrix_free(const TetModel<S>& m, index_t t, const S*
 // ---- Serial loops -------------------------------------------------------
 
 // f = dW/du (overwritten); returns W when `Energy`, else 0. Built-in
-// scalars run the batches (TetModel::batches), the energy summed batch by
+// scalars run the batches (BatchedTetModel::batches), the energy summed batch by
 // batch, lane by lane.
 template <bool Energy, class S>
-double tet_forces(const TetModel<S>& m, const S* u, S* f) {
+double tet_forces(const BatchedTetModel<S>& m, const S* u, S* f) {
     std::fill(f, f + 3 * std::size_t(m.num_vertices), S(0));
     double W = 0;
     if constexpr (std::is_floating_point_v<S>) {
@@ -161,7 +161,7 @@ void tet_energies(const TetModel<S>& m, const S* u, double* energy) {
 }
 
 template <class S>
-void tet_stiffness_all(const TetModel<S>& m, const S* u, TetStiffness<S>& K) {
+void tet_stiffness_all(const BatchedTetModel<S>& m, const S* u, TetStiffness<S>& K) {
     K.K.resize(90 * std::size_t(m.num_tets()));
     if constexpr (std::is_floating_point_v<S>) {
         for (index_t b = 0; b < m.num_batches(); ++b) kernel::batch_stiffness(m, b, u, K.K.data());
@@ -174,7 +174,7 @@ void tet_stiffness_all(const TetModel<S>& m, const S* u, TetStiffness<S>& K) {
 // deformation per batch for both, fused, measured no faster: 51 against
 // 51-53 ns per tet on bunny-4k, 52-53 both on armadillo-7k.)
 template <bool Energy, class S>
-double tet_forces_stiffness(const TetModel<S>& m, const S* u, S* f, TetStiffness<S>& K) {
+double tet_forces_stiffness(const BatchedTetModel<S>& m, const S* u, S* f, TetStiffness<S>& K) {
     const double W = tet_forces<Energy>(m, u, f);
     tet_stiffness_all(m, u, K);
     return W;

@@ -1,4 +1,4 @@
-#include "edgefem/parallel/colouring.hpp"
+#include "cpu/colouring.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -257,7 +257,7 @@ ResourceFn tet_scatter_resources(const TetModel<S>& m) {
 }
 
 template <class S>
-ResourceFn tet_batch_scatter_resources(const TetModel<S>& m) {
+ResourceFn tet_batch_scatter_resources(const BatchedTetModel<S>& m) {
     return [&m](index_t b, std::vector<index_t>& out) {
         for (int k = 0; k < 4; ++k)
             for (int l = 0; l < kTetBatchLanes; ++l) out.push_back(m.batches[b].v[k][l]);
@@ -291,7 +291,7 @@ template ResourceFn tsep_stiffness_resources(const EdgeModel<double>&);
 template ResourceFn tsep_stiffness_resources(const EdgeModel<float>&);
 template ResourceFn tet_scatter_resources(const TetModel<double>&);
 template ResourceFn tet_scatter_resources(const TetModel<float>&);
-template ResourceFn tet_batch_scatter_resources(const TetModel<double>&);
-template ResourceFn tet_batch_scatter_resources(const TetModel<float>&);
+template ResourceFn tet_batch_scatter_resources(const BatchedTetModel<double>&);
+template ResourceFn tet_batch_scatter_resources(const BatchedTetModel<float>&);
 
 }  // namespace edgefem

@@ -1,4 +1,4 @@
-#include "edgefem/core/deformations.hpp"
+#include "lab/deformations.hpp"
 
 #include <algorithm>
 #include <cmath>

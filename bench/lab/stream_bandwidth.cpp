@@ -1,4 +1,4 @@
-#include "edgefem/parallel/stream_bandwidth.hpp"
+#include "lab/stream_bandwidth.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -15,7 +15,7 @@
 
 #include <cstdint>
 
-#include "edgefem/core/edge_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
 
 namespace edgefem::kernel {
 

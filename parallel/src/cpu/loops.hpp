@@ -6,7 +6,7 @@
 #include <algorithm>
 
 #include "edgefem/core/executor.hpp"
-#include "edgefem/parallel/colouring.hpp"
+#include "cpu/colouring.hpp"
 
 namespace edgefem::par {
 

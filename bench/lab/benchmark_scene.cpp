@@ -1,4 +1,4 @@
-#include "edgefem/core/benchmark_scene.hpp"
+#include "lab/benchmark_scene.hpp"
 
 #include <algorithm>
 #include <limits>

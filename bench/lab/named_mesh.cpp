@@ -1,4 +1,4 @@
-#include "edgefem/core/named_mesh.hpp"
+#include "lab/named_mesh.hpp"
 
 #include <cstdlib>
 #include <filesystem>

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "edgefem/core/edge_model.hpp"
-#include "edgefem/core/kernel_inline.hpp"
-#include "edgefem/core/xyz4.hpp"
+#include "cpu/kernel_inline.hpp"
+#include "cpu/xyz4.hpp"
 #include "edgefem/physics/edge_blocks.hpp"
 #include "edgefem/physics/edge_force.hpp"
 #include "edgefem/physics/edge_g.hpp"

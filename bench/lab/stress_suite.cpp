@@ -1,5 +1,5 @@
 // The stability stress suite: see stress_suite.hpp.
-#include "edgefem/core/stress_suite.hpp"
+#include "lab/stress_suite.hpp"
 
 #include <algorithm>
 #include <array>
@@ -14,6 +14,7 @@
 #include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh_quality.hpp"
 #include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
 
 namespace edgefem {
 
@@ -355,7 +356,7 @@ StressResult run_case(const Case& c, Integrator integ, double seconds) {
             s.prescribed = st->targets;
             s.prescribed_steps = std::max<int>(1, int(std::lround(st->ramp / r.dt)));
         }
-        auto sim = std::make_unique<Simulator<double>>(std::move(s));
+        auto sim = std::make_unique<Simulator<double>>(std::move(s), nullptr, cpu_operator_factory<double>());
         std::copy(u.begin(), u.end(), sim->displacement().begin());
         std::copy(v.begin(), v.end(), sim->velocity().begin());
         return sim;

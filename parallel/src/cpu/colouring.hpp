@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "edgefem/core/edge_model.hpp"
-#include "edgefem/core/tet_model.hpp"
+#include "cpu/tet_batches.hpp"
 
 namespace edgefem {
 
@@ -116,11 +116,11 @@ ResourceFn tsep_stiffness_resources(const EdgeModel<S>& m);
 // Per-tet scatter: the tet's 4 vertices.
 template <class S>
 ResourceFn tet_scatter_resources(const TetModel<S>& m);
-// Per-tet batch scatter (TetModel::batches): the 16 vertices of its lanes,
+// Per-tet batch scatter (BatchedTetModel::batches): the 16 vertices of its lanes,
 // padding lanes' vertex 0 included (they add zero to it, but a read-modify-
 // write all the same).
 template <class S>
-ResourceFn tet_batch_scatter_resources(const TetModel<S>& m);
+ResourceFn tet_batch_scatter_resources(const BatchedTetModel<S>& m);
 
 template <class S>
 Colouring colour_edges(const EdgeModel<S>& m, const ColouringOptions& opts = {}) {
@@ -143,7 +143,7 @@ Colouring colour_tets(const TetModel<S>& m, const ColouringOptions& opts = {}) {
     return colour_items(m.num_tets(), m.num_vertices, tet_scatter_resources(m), opts);
 }
 template <class S>
-Colouring colour_tet_batches(const TetModel<S>& m, const ColouringOptions& opts = {}) {
+Colouring colour_tet_batches(const BatchedTetModel<S>& m, const ColouringOptions& opts = {}) {
     return colour_items(m.num_batches(), m.num_vertices, tet_batch_scatter_resources(m), opts);
 }
 

@@ -24,16 +24,16 @@
 #include <memory>
 #include <vector>
 
-#include "edgefem/core/edge_kernel_variants.hpp"
-#include "edgefem/core/edge_kernels.hpp"
+#include "cpu/edge_kernel_variants.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/executor.hpp"
-#include "edgefem/core/tet_edge_form.hpp"
-#include "edgefem/parallel/colouring.hpp"
+#include "cpu/tet_edge_form.hpp"
+#include "cpu/colouring.hpp"
 #include "edgefem/parallel/executors.hpp"
-#include "edgefem/parallel/forward_spill.hpp"
-#include "edgefem/parallel/loops.hpp"
-#include "edgefem/parallel/variant.hpp"
+#include "cpu/forward_spill.hpp"
+#include "cpu/loops.hpp"
+#include "cpu/variant.hpp"
 
 namespace edgefem {
 

@@ -1,5 +1,5 @@
 // The per-tet kernels of core (tet_kernels.hpp) run on an Executor, batch
-// by batch (TetModel::batches, as core's serial loops): the stiffness is
+// by batch (BatchedTetModel::batches, as the serial loops): the stiffness is
 // per batch (no conflicts); forces and K x scatter to the up to 16 vertices
 // of each batch's tets, coloured (batches of one colour share no vertex) or
 // into private accumulators. The per-tet method has no gather or atomic
@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "edgefem/core/executor.hpp"
-#include "edgefem/core/tet_kernels.hpp"
-#include "edgefem/parallel/colouring.hpp"
-#include "edgefem/parallel/loops.hpp"
-#include "edgefem/parallel/variant.hpp"
+#include "cpu/tet_kernels.hpp"
+#include "cpu/colouring.hpp"
+#include "cpu/loops.hpp"
+#include "cpu/variant.hpp"
 
 namespace edgefem {
 
@@ -23,7 +23,7 @@ class ParallelTetKernels {
     static_assert(std::is_floating_point_v<S>, "the batches exist for built-in scalars only");
 
 public:
-    ParallelTetKernels(TetModel<S> model, std::shared_ptr<const Executor> executor, Variant variant,
+    ParallelTetKernels(BatchedTetModel<S> model, std::shared_ptr<const Executor> executor, Variant variant,
                        const PlanOptions& opts = {})
         : m_(std::move(model)),
           ex_(executor ? std::move(executor) : std::make_shared<SerialExecutor>()),
@@ -36,7 +36,7 @@ public:
         }
     }
 
-    const TetModel<S>& model() const { return m_; }
+    const BatchedTetModel<S>& model() const { return m_; }
     Variant variant() const { return variant_; }
     const Colouring& colouring() const { return col_; }
 
@@ -139,7 +139,7 @@ private:
         });
     }
 
-    TetModel<S> m_;
+    BatchedTetModel<S> m_;
     std::shared_ptr<const Executor> ex_;
     Variant variant_;
     index_t range_chunk_;

@@ -1,4 +1,4 @@
-#include "edgefem/parallel/forward_spill.hpp"
+#include "cpu/forward_spill.hpp"
 
 #include <algorithm>
 #include <string>

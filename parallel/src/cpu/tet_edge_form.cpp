@@ -1,4 +1,4 @@
-#include "edgefem/core/tet_edge_form.hpp"
+#include "cpu/tet_edge_form.hpp"
 
 #include <algorithm>
 #include <array>

@@ -20,7 +20,7 @@
 #include <span>
 #include <vector>
 
-#include "edgefem/core/edge_kernels.hpp"
+#include "cpu/edge_kernels.hpp"
 #include "edgefem/core/executor.hpp"
 
 namespace edgefem {
