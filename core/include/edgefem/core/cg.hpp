@@ -1,14 +1,20 @@
 // Preconditioned conjugate gradients on a projected system: constrained
 // degrees of freedom keep the value they have in x on entry, the others solve
-// P A P x = P b. Matrix-free: A and the preconditioner are callables. The
-// vector updates run as fixed blocks on the executor and dot products sum
-// per-block partials in a fixed order: bitwise the same for any thread count.
+// P A P x = P b. Matrix-free: A and the preconditioner are applied by the
+// caller. Declared once as a vector kernel (VectorKernels::cg); the scalar
+// steps and the iteration loop are written here once for every
+// implementation (CgControl, cg_iterations), and conjugate_gradient below is
+// the fused form the CPU back-end runs: the vector updates as fixed blocks
+// on the executor, dot products summed per block in a fixed order, bitwise
+// the same for any thread count.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "edgefem/core/backend_vector.hpp"
 #include "edgefem/core/executor.hpp"
 
 namespace edgefem {
@@ -20,11 +26,94 @@ struct CgResult {
     bool negative_curvature = false;  // met p^T A p <= 0: stopped at the last good iterate
 };
 
-struct CgWork {
-    std::vector<double> r, z, p, Ap;  // double: the iteration's recurrences stay accurate for float A
-    std::vector<double> keep;         // 1 on unknowns, 0 on constrained dofs
-    std::vector<double> partial;      // per-block partial sums (4 per block: p.Ap, r.r, r.z, b.b)
+struct CgSettings {
+    double tolerance = 1e-6;
+    int max_iterations = 500;
+    int fixed_iterations = 0;  // > 0: exactly this many iterations (unless the residual vanishes), no tolerance
 };
+
+// Work vectors, in the memory they are constructed with (host memory by
+// default).
+struct CgWork {
+    CgWork() = default;
+    explicit CgWork(const VectorMemory& memory)
+        : r(memory, 0), z(memory, 0), p(memory, 0), Ap(memory, 0), keep(memory, 0), partial(memory, 0) {}
+    BackendVector<double> r, z, p, Ap;  // double: the iteration's recurrences stay accurate for float A
+    BackendVector<double> keep;         // 1 on unknowns, 0 on constrained dofs
+    BackendVector<double> partial;      // per-block partial sums (4 per block: p.Ap, r.r, r.z, b.b)
+};
+
+// A as the cg kernel applies it, in two parts: products(x, y) overwrites y
+// with the whole-vector part (a stiffness product, free to run its own
+// parallel loops), then finish(lo, hi, x, y) completes y on [lo, hi)
+// (diagonal terms: mass, scaling), on the calling thread.
+class CgSystem {
+public:
+    virtual ~CgSystem() = default;
+    virtual void products(const double* x, double* y) = 0;
+    virtual void finish(std::size_t lo, std::size_t hi, const double* x, double* y) const = 0;
+};
+
+// z = M^-1 r on [lo, hi) from r on [lo, hi) only, on the calling thread;
+// lo and hi are multiples of 3 (whole vertices) or n.
+class CgPreconditioner {
+public:
+    virtual ~CgPreconditioner() = default;
+    virtual void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const = 0;
+};
+
+// CG's scalar steps. bnorm: |P(b - A x_c)|, the norm residuals are
+// relative to (1 when it is 0).
+class CgControl {
+public:
+    CgControl(const CgSettings& settings, double bnorm) : s_(settings), scale_(bnorm > 0 ? bnorm : 1.0) {}
+    double residual(double rr) const { return std::sqrt(rr) / scale_; }
+    bool converged(double residual) const { return s_.fixed_iterations == 0 && residual <= s_.tolerance; }
+    int limit() const { return s_.fixed_iterations > 0 ? s_.fixed_iterations : s_.max_iterations; }
+    double tolerance() const { return s_.tolerance; }
+    // False for p.Ap <= 0 and NaN: x stays at the last good iterate.
+    static bool positive_curvature(double pAp) { return pAp > 0; }
+    static double alpha(double rz, double pAp) { return rz / pAp; }
+    static double beta(double rz_new, double rz) { return rz_new / rz; }
+
+private:
+    CgSettings s_;
+    double scale_;
+};
+
+// The sums one iteration ends with: p.Ap, and r.r, r.z after its update.
+struct CgSums {
+    double pAp = 0, rr = 0, rz = 0;
+};
+
+// CG's iteration loop, after a start pass left r = P(b - A x), z = M^-1 r,
+// p = z with r.r = rr and r.z = rz. iterate(rz) runs one iteration: A p,
+// p.Ap; when CgControl::positive_curvature(p.Ap), alpha, x and r updated,
+// z = M^-1 r; unless then converged, beta and p updated; and returns its
+// sums (rr and rz unused after a non-positive p.Ap).
+template <class Iterate>
+CgResult cg_iterations(const CgControl& c, double rr, double rz, Iterate&& iterate) {
+    CgResult res;
+    res.residual = c.residual(rr);
+    if (c.converged(res.residual)) {
+        res.converged = true;
+        return res;
+    }
+    for (int it = 0; it < c.limit(); ++it) {
+        if (res.residual == 0) break;
+        const CgSums s = iterate(rz);
+        if (!CgControl::positive_curvature(s.pAp)) {
+            res.negative_curvature = true;
+            break;
+        }
+        ++res.iterations;
+        res.residual = c.residual(s.rr);
+        if (c.converged(res.residual)) break;
+        rz = s.rz;
+    }
+    res.converged = !res.negative_curvature && res.residual <= c.tolerance();
+    return res;
+}
 
 // n scalars; free_dof[i] != 0 for unknowns. The system matrix is applied in
 // two parts: apply_A(const double* x, double* y) overwrites y with the
@@ -54,7 +143,8 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
     w.Ap.resize(n);
     w.keep.resize(n);
     const std::size_t nb = vector_blocks(n);
-    w.partial.assign(4 * nb, 0.0);
+    w.partial.resize(4 * nb);
+    std::fill(w.partial.data(), w.partial.data() + 4 * nb, 0.0);
     // The projection multiplies by keep (1 or 0) inside the passes: g++ 12
     // vectorises none of these loops with a select on free_dof in them.
     // A p is not projected in a pass of its own (p is zero on constrained
@@ -82,7 +172,6 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
         for_group_blocks(g, groups, n, [&](std::size_t lo, std::size_t hi) { body(lo, hi, lo / kVectorBlock); });
     };
 
-    CgResult res;
     // The residual is relative to |P(b - A x_c)|, x_c = x's constrained
     // values: the right-hand side the free dofs actually see. With moving
     // constraints (a prescribed ramp, the only load) P b alone is zero, and
@@ -125,17 +214,8 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
         });
     });
     if (!moving_constraints) bnorm = std::sqrt(total(bb_part));
-    const double scale = bnorm > 0 ? bnorm : 1.0;
-    res.residual = std::sqrt(total(rr_part)) / scale;
-    const int limit = fixed_iterations > 0 ? fixed_iterations : max_iterations;
-    if (fixed_iterations == 0 && res.residual <= tolerance) {
-        res.converged = true;
-        return res;
-    }
-    double rz = total(rz_part);
-    const auto converged = [&](double residual) { return fixed_iterations == 0 && residual <= tolerance; };
-    for (int it = 0; it < limit; ++it) {
-        if (res.residual == 0) break;
+    const CgControl control({tolerance, max_iterations, fixed_iterations}, bnorm);
+    return cg_iterations(control, total(rr_part), total(rz_part), [&](double rz) {
         apply_A(p, Ap);
         // Each group sums the partials it needs once, in a fixed order (partials_total).
         ex.for_uniform_phases(3, phase_first, [&, rz](int phase, index_t g) {
@@ -147,9 +227,9 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
                 return;
             }
             const double pAp = total(pap_part);
-            if (!(pAp > 0)) return;  // negative curvature (or NaN): x stays at the last good iterate
+            if (!CgControl::positive_curvature(pAp)) return;
             if (phase == 1) {
-                const double alpha = rz / pAp;
+                const double alpha = CgControl::alpha(rz, pAp);
                 blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
                     for (std::size_t i = lo; i < hi; ++i) {
                         xs[i] += alpha * p[i];
@@ -161,23 +241,14 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
                 });
                 return;
             }
-            if (converged(std::sqrt(total(rr_part)) / scale)) return;
-            const double beta = total(rz_part) / rz;
+            if (control.converged(control.residual(total(rr_part)))) return;
+            const double beta = CgControl::beta(total(rz_part), rz);
             blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t) {
                 for (std::size_t i = lo; i < hi; ++i) p[i] = (z[i] + beta * p[i]) * keep[i];
             });
         });
-        if (!(total(pap_part) > 0)) {  // also catches NaN
-            res.negative_curvature = true;
-            break;
-        }
-        ++res.iterations;
-        res.residual = std::sqrt(total(rr_part)) / scale;
-        if (converged(res.residual)) break;
-        rz = total(rz_part);
-    }
-    res.converged = !res.negative_curvature && res.residual <= tolerance;
-    return res;
+        return CgSums{total(pap_part), total(rr_part), total(rz_part)};
+    });
 }
 
 }  // namespace edgefem

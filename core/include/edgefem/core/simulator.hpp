@@ -8,8 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include <functional>
-
+#include "edgefem/core/backend.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/executor.hpp"
 #include "edgefem/core/scene.hpp"
@@ -60,23 +59,20 @@ struct StaticResult {
     bool converged = false;
 };
 
-// Builds the elastic model a simulator uses: a back-end's operator
-// (cpu_operator_factory in edgefem/parallel/cpu_backend.hpp for the CPU
-// back-end). The default is the reference back-end's
-// (make_reference_operator: plain serial loops).
-template <class S>
-using OperatorFactory =
-    std::function<std::unique_ptr<ElasticOperator<S>>(const Mesh&, const Materials&, ModelKind, Method)>;
-
 template <class S>
 class Simulator {
 public:
     // Validates the scene (InvalidArgument naming the field) and sets up the
     // model; the state starts at rest (u = 0, v = 0). `executor` runs the
     // solver's vector operations (serial when null); `factory` builds the
-    // elastic model (the reference back-end's when empty).
+    // elastic model (the reference back-end's operator when empty):
+    // make_cpu_backend(executor, factory).
     explicit Simulator(Scene scene, std::shared_ptr<const Executor> executor = nullptr,
                        OperatorFactory<S> factory = {});
+    // The same on `backend` (the CPU back-end on one thread when null): the
+    // state and the solvers' vectors live in its memory, and its kernels run
+    // all vector work.
+    Simulator(Scene scene, std::shared_ptr<const ComputeBackend<S>> backend);
     ~Simulator();
     // A moved-from simulator may only be destroyed or assigned to: its other
     // members throw Error.
@@ -99,7 +95,8 @@ public:
     // steps hold the prescribed vertices at their targets.
     StaticResult solve_static();
 
-    // Zero-copy views (3 #V, xyz per vertex). External forces are the
+    // Zero-copy views (3 #V, xyz per vertex) of the back-end's vectors (Error
+    // for a back-end without host memory). External forces are the
     // application's to change between steps (e.g. a haptic probe); forces()
     // holds the internal elastic forces of the last evaluation.
     std::span<S> displacement();

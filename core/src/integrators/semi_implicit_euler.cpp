@@ -1,0 +1,67 @@
+// Linearised backward Euler, one K per step (or per stiffness_interval
+// steps): (c_m M + c_k K) v' = M v + T (h - f(u)) with c_m = 1 + T alpha,
+// c_k = T beta + T^2, then u' = u + T v'; the constrained dofs move to
+// their targets.
+#include <string>
+
+#include "integrators/time_integrator.hpp"
+#include "simulator/messages.hpp"
+
+namespace edgefem::sim {
+
+namespace {
+
+template <class S>
+class SemiImplicitEuler final : public TimeIntegrator<S> {
+public:
+    SemiImplicitEuler(SimState<S>& state, TangentSolve<S>& solve) : s_(state), solve_(solve) {}
+
+    std::optional<double> step(double T) override {
+        const Scene& scene = s_.scene;
+        s_.start_forces();
+        s_.external(1.0);
+        const double c_m = 1 + T * scene.rayleigh_alpha, c_k = T * scene.rayleigh_beta + T * T;
+        // x = v: the warm start.
+        s_.kernels.semi_implicit_rhs(s_.b.data(), s_.x.data(), s_.v.data(), s_.h.data(), s_.f.data(), s_.mass.data(), T,
+                                     s_.n());
+        s_.constrained_velocities(T, s_.time + T, s_.x.data());
+        // Reuse K while the interval allows and the step size is the one it
+        // was built for (a halved step changes the system matrix).
+        const bool reuse = stiffness_age_ > 0 && stiffness_age_ < scene.solver.stiffness_interval && T == stiffness_dt_;
+        const CgResult res = solve_.solve(c_m, c_k, 0.0, nullptr, scene.solver.cg_tolerance,
+                                          scene.solver.definite_stiffness, reuse, scene.solver.cg_fixed_iterations);
+        stiffness_age_ = reuse ? stiffness_age_ + 1 : 1;
+        stiffness_dt_ = T;
+        s_.stats.residual = res.residual;
+        if (!std::isfinite(res.residual))
+            throw StepFailure{"step " + std::to_string(s_.step + 1) + ": linear solve failed (non-finite residual)", -1};
+        if (!res.converged && scene.solver.cg_fixed_iterations == 0 && scene.solver.linear_solver == LinearSolver::CG) {
+            ++s_.stats.unconverged_solves;
+            if (scene.solver.fail_on_unconverged)
+                throw StepFailure{"step " + std::to_string(s_.step + 1) + ": CG stopped at " +
+                                      std::to_string(res.iterations) + " iterations with relative residual " +
+                                      sci(res.residual) + " above the tolerance " + sci(scene.solver.cg_tolerance),
+                                  -1};
+        }
+        s_.take_velocity(T);
+        return std::nullopt;
+    }
+
+private:
+    SimState<S>& s_;
+    TangentSolve<S>& solve_;
+    int stiffness_age_ = 0;    // steps since K was built (0: none yet)
+    double stiffness_dt_ = 0;  // the step size K's system matrix was built for
+};
+
+}  // namespace
+
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_semi_implicit_euler(SimState<S>& state, TangentSolve<S>& solve) {
+    return std::make_unique<SemiImplicitEuler<S>>(state, solve);
+}
+
+template std::unique_ptr<TimeIntegrator<double>> make_semi_implicit_euler(SimState<double>&, TangentSolve<double>&);
+template std::unique_ptr<TimeIntegrator<float>> make_semi_implicit_euler(SimState<float>&, TangentSolve<float>&);
+
+}  // namespace edgefem::sim

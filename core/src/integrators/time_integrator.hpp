@@ -1,0 +1,39 @@
+// One time step of a given size with the scene's integrator. A new
+// integrator is a file with its make_ function and one case in
+// make_time_integrator (time_integrator.cpp).
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include "simulator/state.hpp"
+#include "solvers/tangent_solve.hpp"
+
+namespace edgefem::sim {
+
+template <class S>
+class TimeIntegrator {
+public:
+    virtual ~TimeIntegrator() = default;
+    // Advances u and v by T from the state's time (the time itself is the
+    // caller's to advance); throws StepFailure. Returns the elastic energy
+    // at the new u when the step evaluated it there (the energy guard then
+    // needs no force pass of its own).
+    virtual std::optional<double> step(double T) = 0;
+    // Whether its steps build K (if not, the operator need not keep the
+    // state K is built from).
+    virtual bool builds_stiffness() const { return true; }
+};
+
+// The scene's integrator.
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_time_integrator(SimState<S>& state, TangentSolve<S>& solve);
+
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_explicit_euler(SimState<S>& state);  // explicit_euler.cpp
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_semi_implicit_euler(SimState<S>& state, TangentSolve<S>& solve);
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_implicit_euler(SimState<S>& state, TangentSolve<S>& solve);
+
+}  // namespace edgefem::sim

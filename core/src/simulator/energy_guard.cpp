@@ -1,0 +1,113 @@
+#include "simulator/energy_guard.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "simulator/messages.hpp"
+
+namespace edgefem::sim {
+
+template <class S>
+EnergySample EnergyGuard<S>::sample(double W) const {
+    const std::array<double, 3> s =
+        s_.kernels.energy_sums(s_.u.data(), s_.v.data(), s_.fext.data(), s_.mass.data(), s_.scene.gravity, s_.n());
+    return {s[0], W, s[1], s[2]};
+}
+
+template <class S>
+EnergySample EnergyGuard<S>::start() {
+    const bool same = evaluated_valid_ && s_.kernels.count_differences(s_.u.data(), u_evaluated_.data(), s_.n()) == 0;
+    const double W = same ? W_evaluated_ : s_.forces(true);
+    s_.forces_current = true;
+    return sample(W);
+}
+
+template <class S>
+bool EnergyGuard<S>::constraints_move(double t_end) const {
+    const double tol = 8 * double(std::numeric_limits<S>::epsilon());
+    return s_.kernels.constraints_move(s_.u.data(), s_.constraints(), s_.ramp(t_end), tol);
+}
+
+// The step's gain is its energy change net of the external work (f_ext is
+// constant over the step: f_ext.du) and of what mass damping removed (every
+// integrator applies alpha M v with the new velocity over du = T v: 2 T
+// alpha x kinetic energy), so it is the integrator's own energy error:
+// damping does not hide an injection. Gains accumulate from their lowest
+// level (a one-sided CUSUM: dissipation is no credit for later injection)
+// and may not exceed (max_energy_growth - 1) x the largest kinetic +
+// elastic energy the body has had net of such gains, plus the sums'
+// round-off.
+template <class S>
+void EnergyGuard<S>::check(double T, const EnergySample& start, double W_end, bool constraints_moved) {
+    const Scene& scene = s_.scene;
+    StepStats& stats = s_.stats;
+    s_.copy_state(u_evaluated_, s_.u);
+    W_evaluated_ = W_end;
+    evaluated_valid_ = true;
+    const EnergySample end = sample(W_end);
+    // The reference is net of the gains counted so far: the start's own
+    // kinetic + elastic energy includes them, and with it a steady
+    // growth of 1.2-3x per step raised its own bound and was never
+    // caught (a bent beam, explicit just past the stable dt, reached
+    // 460x its release energy with every step passing).
+    const double scale = std::max(energy_scale_, start.kinetic + start.elastic - energy_excess_);
+    double excess = energy_excess_;
+    if (!constraints_moved) {
+        const double damping = 2 * T * scene.rayleigh_alpha * end.kinetic;
+        const double gain = (end.total() - start.total()) - (end.load - start.load) + damping;
+        const double noise = 256 * double(std::numeric_limits<S>::epsilon()) * (start.magnitude() + end.magnitude());
+        excess += gain;
+        const double limit = scene.solver.max_energy_growth;
+        stats.energy_growth = 1 + std::max(excess, 0.0) / std::max(scale, 1e-300);
+        // A fixed CG budget is a deliberate partial solve, which is not
+        // dissipative: measured, never failed (as fail_on_unconverged).
+        const bool partial = scene.integrator == Integrator::SemiImplicit && scene.solver.cg_fixed_iterations > 0 &&
+                             scene.solver.linear_solver == LinearSolver::CG;
+        if (!partial && !std::isfinite(excess)) {
+            // State finite but its energy not (|u| ~ 1e300 under a huge
+            // load): say so rather than print a NaN ratio.
+            const index_t vertex = s_.fastest_vertex();
+            double umax = 0;
+            std::vector<S> scratch;
+            for (const S x : s_.u.read_host(scratch)) umax = std::max(umax, std::abs(double(x)));
+            throw StepFailure{"step " + std::to_string(s_.step + 1) +
+                                  ": the energy is no longer finite (displacements up to " + sci(umax) +
+                                  " m): the state left the range of floating point; fastest vertex " +
+                                  std::to_string(vertex) + " (check the loads, the units and dt)",
+                              vertex};
+        }
+        if (!partial && !(excess <= (limit - 1) * scale + noise)) {
+            const index_t vertex = s_.fastest_vertex();
+            char ratio[48], lim[32];
+            std::snprintf(ratio, sizeof ratio, "+%.3g x", excess / std::max(scale, 1e-300));
+            std::snprintf(lim, sizeof lim, "%g", limit);
+            // From rest (no kinetic or elastic energy yet) a ratio means
+            // nothing (it printed +6e288 x): give the gain itself.
+            const bool from_rest = !(excess < 1e12 * scale);
+            throw StepFailure{"step " + std::to_string(s_.step + 1) + ": energy grew without a source: " +
+                                  (from_rest ? "a gain of " + sci(excess) +
+                                                   " J net of the external work, by a body that had no kinetic or "
+                                                   "elastic energy to speak of (" + sci(scale) + " J)"
+                                             : std::string(ratio) +
+                                                   " the largest kinetic + elastic energy seen (a gain of " +
+                                                   sci(excess) +
+                                                   " J net of the external work since its lowest level; largest " +
+                                                   sci(scale) + " J)") +
+                                  ", over solver.max_energy_growth = " + lim + "; fastest vertex " +
+                                  std::to_string(vertex) +
+                                  " (unstable: reduce dt, use the implicit integrator or improve the mesh's worst tets)",
+                              vertex};
+        }
+        excess = std::max(0.0, excess);
+    }
+    if (constraints_moved) stats.energy_growth = 1 + excess / std::max(scale, 1e-300);
+    energy_excess_ = excess;
+    energy_scale_ = std::max(scale, end.kinetic + end.elastic - excess);
+}
+
+template class EnergyGuard<double>;
+template class EnergyGuard<float>;
+
+}  // namespace edgefem::sim

@@ -1,0 +1,60 @@
+// The energy guard (SolverSettings::max_energy_growth): a step fails when
+// the total energy has grown, net of the external work and of what mass
+// damping removed, by more than the allowed factor of the largest kinetic +
+// elastic energy seen.
+// In: the state before and after a step. Out: StepStats::energy_growth, or
+// a StepFailure.
+#pragma once
+
+#include <cmath>
+
+#include "simulator/state.hpp"
+
+namespace edgefem::sim {
+
+// The guard's view of a state.
+struct EnergySample {
+    double kinetic = 0, elastic = 0;
+    double gravity = 0;  // -m g.u (the constant -m g.X left out: only differences count)
+    double load = 0;     // f_ext.u with the step's f_ext: its change is the external work
+    double total() const { return kinetic + elastic + gravity; }
+    double magnitude() const { return kinetic + std::abs(elastic) + std::abs(gravity) + std::abs(load); }
+};
+
+template <class S>
+class EnergyGuard {
+public:
+    explicit EnergyGuard(SimState<S>& state) : s_(state), u_evaluated_(state.template vector<S>(0)) {}
+    bool enabled() const { return s_.scene.solver.max_energy_growth > 0; }
+
+    // The state at the start of a step. The elastic energy comes from the
+    // guard's force pass at the end of the last step when u is unchanged
+    // since (then f is current too and the step skips its force pass), else
+    // from a force pass here. Edits the application made between steps are
+    // thereby part of the starting energy, not of the step's gain.
+    EnergySample start();
+
+    // Whether a step from the current state to t_end moves a fixed or
+    // prescribed vertex (a prescribed ramp, or a vertex the application
+    // displaced): the constraint's work is unknown, so the guard skips it.
+    bool constraints_move(double t_end) const;
+
+    // After a step of size T that started at `start` and ends with elastic
+    // energy W_end.
+    void check(double T, const EnergySample& start, double W_end, bool constraints_moved);
+
+private:
+    EnergySample sample(double W) const;
+
+    SimState<S>& s_;
+    BackendVector<S> u_evaluated_;  // the u that f, the operator's state and W_evaluated_ belong to
+    double W_evaluated_ = 0;
+    bool evaluated_valid_ = false;
+    double energy_excess_ = 0;  // energy gained net of work since its lowest level (>= 0)
+    double energy_scale_ = 0;   // largest kinetic + elastic energy seen
+};
+
+extern template class EnergyGuard<double>;
+extern template class EnergyGuard<float>;
+
+}  // namespace edgefem::sim

@@ -1,0 +1,136 @@
+#include "simulator/state.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "edgefem/core/coefficients.hpp"
+#include "simulator/timing.hpp"
+
+namespace edgefem::sim {
+
+template <class S>
+SimState<S>::SimState(Scene s, std::shared_ptr<const ComputeBackend<S>> back)
+    : scene((s.validate(), std::move(s))),
+      backend(back ? std::move(back) : make_cpu_backend<S>()),
+      kernels(backend->kernels()) {
+    const Mesh& mesh = scene.mesh;
+    op = backend->make_operator(mesh, scene.materials, scene.model, scene.method);
+    mass_host = edgefem::lumped_mass(mesh, scene.materials);
+    const std::size_t nv = mass_host.size(), nd = 3 * nv;
+    std::vector<double> per_dof(nd);
+    for (std::size_t i = 0; i < nd; ++i) per_dof[i] = mass_host[i / 3];
+    mass = vector<double>(nv);
+    mass.write(mass_host);
+    mass_dof = vector<double>(nd);
+    mass_dof.write(per_dof);
+    u = vector<S>(nd);
+    v = vector<S>(nd);
+    fext = vector<S>(nd);
+    f = vector<S>(nd);
+    std::vector<index_t> cv;
+    std::vector<double> cd;
+    for (index_t vtx : scene.fixed) {
+        cv.push_back(vtx);
+        cd.insert(cd.end(), {0.0, 0.0, 0.0});
+    }
+    for (const auto& p : scene.prescribed) {
+        cv.push_back(p.vertex);
+        for (int r = 0; r < 3; ++r) cd.push_back(p.target[r] - mesh.X[3 * std::size_t(p.vertex) + r]);
+    }
+    free_host.assign(nd, 1);
+    for (index_t vtx : cv)
+        for (int r = 0; r < 3; ++r) free_host[3 * std::size_t(vtx) + r] = 0;
+    free_dof = vector<std::uint8_t>(nd);
+    free_dof.write(free_host);
+    con_vertex = vector<index_t>(cv.size());
+    con_vertex.write(cv);
+    con_disp = vector<double>(cd.size());
+    con_disp.write(cd);
+    for (std::size_t i = 0; i < nv; ++i)
+        if (!(mass_host[i] > 0))
+            throw InvalidArgument("scene: vertex " + std::to_string(i) + " has no mass (unreferenced vertex?)");
+    h = vector<double>(nd);
+    x = vector<double>(nd);
+    b = vector<double>(nd);
+}
+
+template <class S>
+void SimState<S>::copy_state(BackendVector<S>& dst, const BackendVector<S>& src) const {
+    dst.resize(src.size());
+    kernels.copy_state(dst.data(), src.data(), src.size());
+}
+
+template <class S>
+void SimState<S>::external(double load) {
+    kernels.external_load(h.data(), fext.data(), mass.data(), scene.gravity, load, n());
+}
+
+template <class S>
+double SimState<S>::ramp(double t) const {
+    return std::max(ramp_floor, std::min(1.0, t / (scene.prescribed_steps * scene.dt) * (1 + 1e-12)));
+}
+
+template <class S>
+void SimState<S>::constrained_velocities(double T, double t_end, double* vel) const {
+    kernels.constrained_velocities(vel, u.data(), constraints(), ramp(t_end), T);
+}
+
+template <class S>
+void SimState<S>::take_velocity(double T) {
+    kernels.take_velocity(u.data(), v.data(), x.data(), T, n());
+}
+
+template <class S>
+void SimState<S>::hold_constraints(double fraction) {
+    kernels.hold_constraints(u.data(), constraints(), fraction);
+}
+
+template <class S>
+double SimState<S>::forces(bool energy) {
+    const auto t0 = Clock::now();
+    const double W = op->forces(u.data(), f.data(), energy);
+    stats.force_ms += ms_since(t0);
+    return W;
+}
+
+template <class S>
+void SimState<S>::start_forces() {
+    if (!forces_current) forces(false);
+    forces_current = false;
+}
+
+template <class S>
+void SimState<S>::check_finite(long step_no) const {
+    const std::size_t i = kernels.first_non_finite(u.data(), v.data(), n());
+    if (i < n()) {
+        std::vector<S> scratch;
+        const bool u_finite = std::isfinite(double(u.read_host(scratch)[i]));
+        throw StepFailure{"step " + std::to_string(step_no) + ": non-finite " +
+                              (u_finite ? "velocity" : "displacement") + " at vertex " + std::to_string(i / 3) +
+                              " (unstable: reduce dt or use an implicit integrator)",
+                          index_t(i / 3)};
+    }
+}
+
+template <class S>
+index_t SimState<S>::fastest_vertex() const {
+    std::vector<S> scratch;
+    const std::span<const S> vel = v.read_host(scratch);
+    index_t best = 0;
+    double top = -1;
+    for (std::size_t vtx = 0; vtx < mass_host.size(); ++vtx) {
+        const double s2 = double(vel[3 * vtx]) * double(vel[3 * vtx]) +
+                          double(vel[3 * vtx + 1]) * double(vel[3 * vtx + 1]) +
+                          double(vel[3 * vtx + 2]) * double(vel[3 * vtx + 2]);
+        if (s2 > top) {
+            top = s2;
+            best = index_t(vtx);
+        }
+    }
+    return best;
+}
+
+template struct SimState<double>;
+template struct SimState<float>;
+
+}  // namespace edgefem::sim

@@ -1,0 +1,84 @@
+// The state a Simulator advances, shared by its integrators, solvers and
+// energy guard: the scene, the back-end with its kernels, the elastic
+// operator, the lumped mass, the vectors (3 #V each, in the back-end's
+// memory), the constraints, the time and the step's statistics.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "edgefem/core/simulator.hpp"
+
+namespace edgefem::sim {
+
+// A failed step, caught to retry with a halved step.
+struct StepFailure {
+    std::string message;
+    index_t vertex;
+};
+
+template <class S>
+struct SimState {
+    Scene scene;
+    std::shared_ptr<const ComputeBackend<S>> backend;
+    const VectorKernels<S>& kernels;
+    std::unique_ptr<ElasticOperator<S>> op;
+    std::vector<double> mass_host;          // #V, on the host: lumped_mass(), the assembled system
+    std::vector<std::uint8_t> free_host;    // 3 #V, on the host: the assembled system's numbering
+    BackendVector<double> mass;             // #V
+    BackendVector<double> mass_dof;         // 3 #V: mass per dof, for loops that vectorise
+    BackendVector<S> u, v, fext, f;         // 3 #V
+    BackendVector<std::uint8_t> free_dof;   // 3 #V: 1 on unknowns
+    BackendVector<index_t> con_vertex;      // fixed and prescribed vertices
+    BackendVector<double> con_disp;         // their final displacement (3 each)
+    double ramp_floor = 0;                  // 1 after solve_static: the prescribed targets are reached
+    bool forces_current = false;  // f is at the step's starting u: the step skips its force pass
+    BackendVector<double> h;      // external load (external())
+    BackendVector<double> b, x;   // the linear solves' right-hand side and solution
+    StepStats stats;
+    long step = 0;
+    double time = 0;
+
+    // Validates the scene, builds the operator (on the CPU back-end on one
+    // thread when `back` is null) and the lumped mass; the state at rest.
+    SimState(Scene s, std::shared_ptr<const ComputeBackend<S>> back);
+
+    std::size_t n() const { return u.size(); }
+    // n zeros in the back-end's memory.
+    template <class T>
+    BackendVector<T> vector(std::size_t size) const {
+        return backend->template vector<T>(size);
+    }
+    ConstraintView constraints() const { return {con_vertex.data(), con_disp.data(), con_vertex.size()}; }
+    // dst = src (dst resized).
+    void copy_state(BackendVector<S>& dst, const BackendVector<S>& src) const;
+
+    // External load h = load (M g + f_ext).
+    void external(double load);
+    // Fraction of the prescribed targets reached at time t.
+    double ramp(double t) const;
+    // Constrained velocities that reach the targets at time t_end.
+    void constrained_velocities(double T, double t_end, double* vel) const;
+    // x as the new velocity after a step of size T: v = x, u += T x.
+    void take_velocity(double T);
+    // The constrained displacements at `fraction` of their targets.
+    void hold_constraints(double fraction);
+
+    // f at u (timed as force_ms); W when `energy`.
+    double forces(bool energy);
+    // The internal forces at the step's start, unless the energy guard has
+    // just evaluated them at this state.
+    void start_forces();
+
+    // StepFailure naming the first non-finite dof of u or v.
+    void check_finite(long step_no) const;
+    // The vertex with the largest speed (for messages).
+    index_t fastest_vertex() const;
+};
+
+extern template struct SimState<double>;
+extern template struct SimState<float>;
+
+}  // namespace edgefem::sim

@@ -1,0 +1,70 @@
+#include "simulator/step_control.hpp"
+
+namespace edgefem::sim {
+
+template <class S>
+void StepControl<S>::advance(double T, int depth) {
+    // The state is saved only when a failed step may be retried (the
+    // whole step's start is kept by step()).
+    const bool may_retry = depth < s_.scene.solver.max_step_halvings;
+    // Depth 0 restores the step's start, which step() has just saved.
+    BackendVector<S> u_save = s_.template vector<S>(0), v_save = s_.template vector<S>(0);
+    if (may_retry && depth > 0) {
+        s_.copy_state(u_save, s_.u);
+        s_.copy_state(v_save, s_.v);
+    }
+    try {
+        s_.forces_current = false;
+        const bool guard = guard_.enabled();
+        EnergySample start;
+        bool moved = false;
+        if (guard) {
+            moved = guard_.constraints_move(s_.time + T);
+            start = guard_.start();
+        }
+        const std::optional<double> W_end = integrator_.step(T);
+        s_.check_finite(s_.step + 1);
+        // The force pass here, if the step has none at its end, is the one
+        // the next step starts with.
+        if (guard) guard_.check(T, start, W_end ? *W_end : s_.forces(true), moved);
+        s_.time += T;
+    } catch (const StepFailure& failure) {
+        s_.forces_current = false;
+        if (!may_retry) throw;
+        s_.copy_state(s_.u, depth == 0 ? step_start_u_ : u_save);
+        s_.copy_state(s_.v, depth == 0 ? step_start_v_ : v_save);
+        ++s_.stats.halvings;
+        advance(T / 2, depth + 1);
+        advance(T / 2, depth + 1);
+    }
+}
+
+template <class S>
+const StepStats& StepControl<S>::step() {
+    s_.stats = StepStats{};
+    const double t_start = s_.time;
+    // The state before the step, restored when it fails: a failed step
+    // left its rejected (often exploded) state behind, and a later step
+    // or energies() went on from it as if nothing had happened.
+    // Persistent buffers: one copy per step, no allocation.
+    s_.copy_state(step_start_u_, s_.u);
+    s_.copy_state(step_start_v_, s_.v);
+    try {
+        advance(s_.scene.dt, 0);
+    } catch (const StepFailure& failure) {
+        s_.time = t_start;
+        s_.copy_state(s_.u, step_start_u_);
+        s_.copy_state(s_.v, step_start_v_);
+        s_.forces_current = false;
+        throw SimulationError(failure.message, s_.step + 1, failure.vertex);
+    }
+    s_.time = t_start + s_.scene.dt;  // no drift from summed halves
+    ++s_.step;
+    if (s_.scene.count_inverted_tets) s_.stats.inverted_tets = s_.op->inverted_tets(s_.u.data());
+    return s_.stats;
+}
+
+template class StepControl<double>;
+template class StepControl<float>;
+
+}  // namespace edgefem::sim

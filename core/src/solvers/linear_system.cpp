@@ -1,0 +1,41 @@
+#include "solvers/linear_system.hpp"
+
+namespace edgefem::sim {
+
+template <class S>
+void LinearSystem<S>::multiply(const ElasticOperator<S>& op, const double* in, double* out) {
+    if constexpr (std::is_same_v<S, double>) {
+        op.multiply(in, out);
+    } else {
+        xs_.resize(s_.n());
+        ys_.resize(s_.n());
+        s_.kernels.to_state(xs_.data(), in, s_.n());
+        op.multiply(xs_.data(), ys_.data());
+        s_.kernels.from_state(out, ys_.data(), s_.n());
+    }
+}
+
+template <class S>
+void LinearSystem<S>::products(const double* in, double* out) {
+    multiply(*s_.op, in, out);
+    if (c_b_ != 0) {
+        Ax_.resize(s_.n());
+        multiply(*K0_, in, Ax_.data());
+    }
+}
+
+template <class S>
+void LinearSystem<S>::finish(std::size_t lo, std::size_t hi, const double* in, double* out) const {
+    s_.kernels.system_diagonal_range(lo, hi, c_m_, c_k_, c_b_, s_.mass_dof.data(), in, Ax_.data(), out);
+}
+
+template <class S>
+void LinearSystem<S>::apply(const double* in, double* out) {
+    products(in, out);
+    s_.kernels.system_diagonal(s_.n(), c_m_, c_k_, c_b_, s_.mass_dof.data(), in, Ax_.data(), out);
+}
+
+template class LinearSystem<double>;
+template class LinearSystem<float>;
+
+}  // namespace edgefem::sim

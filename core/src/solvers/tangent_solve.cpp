@@ -1,0 +1,44 @@
+#include "solvers/tangent_solve.hpp"
+
+#include "simulator/timing.hpp"
+
+namespace edgefem::sim {
+
+template <class S>
+TangentSolve<S>::TangentSolve(SimState<S>& state) : s_(state), system_(state), solver_(make_system_solver(state)) {}
+
+template <class S>
+CgResult TangentSolve<S>::solve(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
+                                bool definite, bool reuse_stiffness, int fixed_iterations) {
+    CgResult res = solve_once(c_m, c_k, c_b, K0, tolerance, definite, reuse_stiffness, fixed_iterations);
+    if (res.negative_curvature && !definite && s_.scene.method == Method::Edge) {
+        s_.stats.negative_curvature = true;
+        const int its = res.iterations;
+        res = solve_once(c_m, c_k, c_b, K0, tolerance, true, false, fixed_iterations);
+        res.iterations += its;
+    }
+    return res;
+}
+
+template <class S>
+CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0,
+                                     double tolerance, bool definite, bool reuse_stiffness, int fixed_iterations) {
+    auto t0 = Clock::now();
+    reuse_stiffness = reuse_stiffness && solver_->reusable();
+    system_.set(c_m, c_k, c_b, K0);
+    if (!reuse_stiffness) {
+        s_.op->build_stiffness(definite);
+        solver_->setup(system_);
+    }
+    s_.stats.stiffness_ms += ms_since(t0);
+    t0 = Clock::now();
+    const CgResult res = solver_->solve(system_, s_.b, s_.x, tolerance, fixed_iterations);
+    s_.stats.solve_ms += ms_since(t0);
+    s_.stats.solver_iterations += res.iterations;
+    return res;
+}
+
+template class TangentSolve<double>;
+template class TangentSolve<float>;
+
+}  // namespace edgefem::sim

@@ -1,0 +1,44 @@
+// The linear solve of an implicit step: builds K at the operator's last
+// forces() state (definite if asked), sets up the scene's SystemSolver and
+// solves A x = b with the state's b and x (x: the constrained values and a
+// warm start). On negative curvature with the plain K (edge method) it
+// retries once with the definite K. Times go to StepStats (stiffness_ms,
+// solve_ms) with the iterations.
+#pragma once
+
+#include <memory>
+
+#include "solvers/system_solver.hpp"
+
+namespace edgefem::sim {
+
+template <class S>
+class TangentSolve {
+public:
+    explicit TangentSolve(SimState<S>& state);
+
+    LinearSystem<S>& system() { return system_; }
+
+    // A = c_m M + c_k K + c_b K0 (K0: null when c_b = 0).
+    // `reuse_stiffness`: keep the K and set-up of an earlier solve (when
+    // the solver allows; SolverSettings::stiffness_interval).
+    // `fixed_iterations` > 0: exactly that many CG iterations (the
+    // semi-implicit step's budget, cg_fixed_iterations; Newton's solves
+    // always run to their tolerance: with the budget they failed to
+    // converge).
+    CgResult solve(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance, bool definite,
+                   bool reuse_stiffness = false, int fixed_iterations = 0);
+    // The same without the retry.
+    CgResult solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
+                        bool definite, bool reuse_stiffness = false, int fixed_iterations = 0);
+
+private:
+    SimState<S>& s_;
+    LinearSystem<S> system_;
+    std::unique_ptr<SystemSolver<S>> solver_;
+};
+
+extern template class TangentSolve<double>;
+extern template class TangentSolve<float>;
+
+}  // namespace edgefem::sim
