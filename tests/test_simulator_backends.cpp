@@ -45,7 +45,7 @@ public:
 };
 
 // The CPU back-end on PretendDeviceMemory.
-class PretendDeviceBackend final : public ComputeBackend<double> {
+class PretendDeviceBackend final : public Backend<double> {
 public:
     const char* name() const override { return "pretend-device"; }
     int threads() const override { return 1; }
@@ -57,7 +57,7 @@ public:
     const VectorMemory& memory() const override { return memory_; }
 
 private:
-    std::shared_ptr<const ComputeBackend<double>> cpu_ = make_cpu_backend<double>();
+    std::shared_ptr<const Backend<double>> cpu_ = make_cpu_backend<double>();
     PretendDeviceMemory memory_;
 };
 
@@ -314,7 +314,7 @@ Scene explicit_scene() {
     return s;
 }
 
-SimRun simulate(const Scene& scene, std::shared_ptr<const ComputeBackend<double>> backend, int steps,
+SimRun simulate(const Scene& scene, std::shared_ptr<const Backend<double>> backend, int steps,
              bool static_first = false) {
     Simulator<double> sim(scene, std::move(backend));
     SimRun r;
@@ -382,7 +382,7 @@ TEST(VectorKernels, ReferenceAndCpuAgree) {
     }
     EXPECT_LE(worst, 1e-12) << "at output " << worst_at;
     for (int threads : {2, 3}) {
-        const auto ex = make_executor(Backend::OpenMP, threads);
+        const auto ex = make_executor(ExecutorKind::OpenMP, threads);
         EXPECT_TRUE(same_bits(run_kernels(make_cpu_backend<double>(ex)->kernels(), in), serial)) << threads;
     }
 }
@@ -435,7 +435,7 @@ TEST(VectorKernels, CgReferenceAndFusedAgree) {
     const CgRun fixed = run_cg(make_cpu_backend<double>()->kernels(), in, 7);
     EXPECT_EQ(fixed.res.iterations, 7);
     for (int threads : {2, 3}) {
-        const auto ex = make_executor(Backend::OpenMP, threads);
+        const auto ex = make_executor(ExecutorKind::OpenMP, threads);
         const CgRun par = run_cg(make_cpu_backend<double>(ex)->kernels(), in, 0);
         EXPECT_TRUE(same_bits(par.x, cpu.x)) << threads;
         EXPECT_EQ(par.res.iterations, cpu.res.iterations);
@@ -460,7 +460,7 @@ TEST(Backends, SimulatorOnReferenceAndCpuAgree) {
                             {"implicit", implicit_scene(), 3, false},
                             {"explicit", explicit_scene(), 20, false},
                             {"static", test::clamped_box_scene(8, 3, 3), 1, true}};
-    const auto omp2 = make_executor(Backend::OpenMP, 2);
+    const auto omp2 = make_executor(ExecutorKind::OpenMP, 2);
     for (const Case& c : cases) {
         const SimRun ref = simulate(c.scene, make_reference_backend<double>(), c.steps, c.static_first);
         ASSERT_GT(test::max_abs(ref.state), 0) << c.name;
@@ -493,7 +493,7 @@ TEST(Backends, CpuBackendBitwiseAcrossThreadCounts) {
                                        base.state.end() - std::ptrdiff_t(u.size()));
         EXPECT_TRUE(same_bits(u, tail));
     }
-    for (Backend b : {Backend::OpenMP, Backend::TBB, Backend::Pool})
+    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (int t : test::test_thread_counts()) {
             const auto ex = make_executor(b, t);
             const SimRun par = simulate(scene, gather_backend(ex), 2);
@@ -541,7 +541,7 @@ TEST(Backends, DeviceMemoryIsNeverReadOnTheHostInAStep) {
 TEST(Backends, NamesAndThreads) {
     EXPECT_STREQ(make_reference_backend<double>()->name(), "reference");
     EXPECT_STREQ(make_cpu_backend<float>()->name(), "serial");
-    const auto ex = make_executor(Backend::OpenMP, 2);
+    const auto ex = make_executor(ExecutorKind::OpenMP, 2);
     EXPECT_EQ(make_cpu_backend<double>(ex)->threads(), 2);
     EXPECT_STREQ(make_cpu_backend<double>(ex)->name(), "omp");
 }

@@ -26,7 +26,7 @@ public:
 };
 
 template <class S>
-class CpuBackend final : public ComputeBackend<S> {
+class CpuBackend final : public Backend<S> {
 public:
     CpuBackend(std::shared_ptr<const Executor> ex, OperatorFactory<S> factory)
         : ex_(std::move(ex)), factory_(std::move(factory)), kernels_(ex_) {}
@@ -49,15 +49,15 @@ private:
 }  // namespace
 
 template <class S>
-std::shared_ptr<const ComputeBackend<S>> make_cpu_backend(std::shared_ptr<const Executor> executor,
+std::shared_ptr<const Backend<S>> make_cpu_backend(std::shared_ptr<const Executor> executor,
                                                           OperatorFactory<S> factory) {
     if (!executor) executor = std::make_shared<SerialExecutor>();
     return std::make_shared<CpuBackend<S>>(std::move(executor), std::move(factory));
 }
 
-template std::shared_ptr<const ComputeBackend<double>> make_cpu_backend(std::shared_ptr<const Executor>,
+template std::shared_ptr<const Backend<double>> make_cpu_backend(std::shared_ptr<const Executor>,
                                                                         OperatorFactory<double>);
-template std::shared_ptr<const ComputeBackend<float>> make_cpu_backend(std::shared_ptr<const Executor>,
+template std::shared_ptr<const Backend<float>> make_cpu_backend(std::shared_ptr<const Executor>,
                                                                        OperatorFactory<float>);
 
 }  // namespace edgefem

@@ -22,7 +22,7 @@ public:
 };
 
 template <class S>
-class ReferenceBackend final : public ComputeBackend<S> {
+class ReferenceBackend final : public Backend<S> {
 public:
     const char* name() const override { return "reference"; }
     int threads() const override { return 1; }
@@ -40,11 +40,11 @@ private:
 }  // namespace
 
 template <class S>
-std::shared_ptr<const ComputeBackend<S>> make_reference_backend() {
+std::shared_ptr<const Backend<S>> make_reference_backend() {
     return std::make_shared<ReferenceBackend<S>>();
 }
 
-template std::shared_ptr<const ComputeBackend<double>> make_reference_backend();
-template std::shared_ptr<const ComputeBackend<float>> make_reference_backend();
+template std::shared_ptr<const Backend<double>> make_reference_backend();
+template std::shared_ptr<const Backend<float>> make_reference_backend();
 
 }  // namespace edgefem

@@ -19,7 +19,7 @@ struct Simulator<S>::Impl {
     std::unique_ptr<sim::TimeIntegrator<S>> integrator;
     sim::StepControl<S> control;
 
-    Impl(Scene scene, std::shared_ptr<const ComputeBackend<S>> backend)
+    Impl(Scene scene, std::shared_ptr<const Backend<S>> backend)
         : state(std::move(scene), std::move(backend)),
           solve(state),
           integrator(sim::make_time_integrator(state, solve)),
@@ -46,7 +46,7 @@ template <class S>
 Simulator<S>::Simulator(Scene scene, std::shared_ptr<const Executor> executor, OperatorFactory<S> factory)
     : impl_(std::make_unique<Impl>(std::move(scene), make_cpu_backend<S>(std::move(executor), std::move(factory)))) {}
 template <class S>
-Simulator<S>::Simulator(Scene scene, std::shared_ptr<const ComputeBackend<S>> backend)
+Simulator<S>::Simulator(Scene scene, std::shared_ptr<const Backend<S>> backend)
     : impl_(std::make_unique<Impl>(std::move(scene), std::move(backend))) {}
 template <class S>
 Simulator<S>::~Simulator() = default;

@@ -9,7 +9,7 @@
 namespace edgefem::sim {
 
 template <class S>
-SimState<S>::SimState(Scene s, std::shared_ptr<const ComputeBackend<S>> back)
+SimState<S>::SimState(Scene s, std::shared_ptr<const Backend<S>> back)
     : scene((s.validate(), std::move(s))),
       backend(back ? std::move(back) : make_cpu_backend<S>()),
       kernels(backend->kernels()) {

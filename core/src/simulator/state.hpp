@@ -22,7 +22,7 @@ struct StepFailure {
 template <class S>
 struct SimState {
     Scene scene;
-    std::shared_ptr<const ComputeBackend<S>> backend;
+    std::shared_ptr<const Backend<S>> backend;
     const VectorKernels<S>& kernels;
     std::unique_ptr<ElasticOperator<S>> op;
     std::vector<double> mass_host;          // #V, on the host: lumped_mass(), the assembled system
@@ -43,7 +43,7 @@ struct SimState {
 
     // Validates the scene, builds the operator (on the CPU back-end on one
     // thread when `back` is null) and the lumped mass; the state at rest.
-    SimState(Scene s, std::shared_ptr<const ComputeBackend<S>> back);
+    SimState(Scene s, std::shared_ptr<const Backend<S>> back);
 
     std::size_t n() const { return u.size(); }
     // n zeros in the back-end's memory.

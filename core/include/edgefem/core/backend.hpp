@@ -26,11 +26,10 @@ template <class S>
 using OperatorFactory =
     std::function<std::unique_ptr<ElasticOperator<S>>(const Mesh&, const Materials&, ModelKind, Method)>;
 
-// (Not named Backend: parallel/executors.hpp's Backend names an executor.)
 template <class S>
-class ComputeBackend {
+class Backend {
 public:
-    virtual ~ComputeBackend() = default;
+    virtual ~Backend() = default;
     virtual const char* name() const = 0;
     virtual int threads() const = 0;
     // An operator whose vectors (u, f, K x) are in memory().
@@ -48,7 +47,7 @@ public:
 // Plain serial loops in index order, for the vectors and the operator
 // (make_reference_operator): slow, simple, the reference results.
 template <class S>
-std::shared_ptr<const ComputeBackend<S>> make_reference_backend();
+std::shared_ptr<const Backend<S>> make_reference_backend();
 
 // Vector kernels in fixed blocks on `executor` (serial when null), the
 // results the same for any thread count; operators from `factory` (the
@@ -56,7 +55,7 @@ std::shared_ptr<const ComputeBackend<S>> make_reference_backend();
 // edgefem/parallel/cpu_backend.hpp for the tuned ones). What
 // Simulator(scene) runs on.
 template <class S>
-std::shared_ptr<const ComputeBackend<S>> make_cpu_backend(std::shared_ptr<const Executor> executor = nullptr,
+std::shared_ptr<const Backend<S>> make_cpu_backend(std::shared_ptr<const Executor> executor = nullptr,
                                                           OperatorFactory<S> factory = {});
 
 }  // namespace edgefem

@@ -72,7 +72,7 @@ public:
     // The same on `backend` (the CPU back-end on one thread when null): the
     // state and the solvers' vectors live in its memory, and its kernels run
     // all vector work.
-    Simulator(Scene scene, std::shared_ptr<const ComputeBackend<S>> backend);
+    Simulator(Scene scene, std::shared_ptr<const Backend<S>> backend);
     ~Simulator();
     // A moved-from simulator may only be destroyed or assigned to: its other
     // members throw Error.
