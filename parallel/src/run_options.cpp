@@ -1,8 +1,5 @@
 #include "edgefem/parallel/run_options.hpp"
 
-#include <algorithm>
-#include <initializer_list>
-
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/reference_operator.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"
@@ -13,12 +10,14 @@ namespace edgefem {
 
 namespace {
 
-void require_one_of(const std::string& option, const std::string& value, std::initializer_list<const char*> accepted) {
-    for (const char* a : accepted)
-        if (value == a) return;
-    std::string list;
-    for (const char* a : accepted) list += std::string(list.empty() ? "" : ", ") + a;
-    throw InvalidArgument("run option " + option + ": unknown value '" + value + "' (expected " + list + ")");
+// parse(value), its InvalidArgument prefixed with the option's name.
+template <class Parse>
+void check_option(const char* option, const std::string& value, Parse&& parse) {
+    try {
+        parse(value);
+    } catch (const InvalidArgument& e) {
+        throw InvalidArgument(std::string("run option ") + option + ": " + e.what());
+    }
 }
 
 bool uses_executor(const RunOptions& run) {
@@ -28,14 +27,22 @@ bool uses_executor(const RunOptions& run) {
 }  // namespace
 
 void validate(const RunOptions& run) {
-    require_one_of("backend", run.backend, {"auto", "reference", "serial", "omp", "tbb", "pool"});
+    // auto and reference, then the executors' kinds.
+    if (run.backend != "auto" && run.backend != "reference")
+        check_option("backend", run.backend, [](const std::string& b) {
+            try {
+                parse_executor_kind(b);
+            } catch (const InvalidArgument&) {
+                throw InvalidArgument("unknown value '" + b + "' (expected auto, reference, serial, omp, tbb or pool)");
+            }
+        });
     if (run.threads < 0 || run.threads > kMaxThreads)
         throw InvalidArgument("run option threads: " + std::to_string(run.threads) + " is outside 0.." +
                               std::to_string(kMaxThreads) + " (0: every hardware thread)");
-    require_one_of("variant", run.variant, {"auto", "colour", "color", "gather", "atomic", "private", "owner"});
-    require_one_of("schedule", run.schedule, {"static", "dynamic"});
-    require_one_of("ordering", run.ordering, {"input", "random", "rcm", "morton", "nd", "metis"});
-    require_one_of("layout", run.layout, {"tet-local", "tsep-list"});
+    check_option("variant", run.variant, [](const std::string& v) { parse_variant(v); });
+    check_option("schedule", run.schedule, [](const std::string& v) { parse_schedule(v); });
+    check_option("ordering", run.ordering, [](const std::string& v) { parse_ordering(v); });
+    check_option("layout", run.layout, [](const std::string& v) { parse_stiffness_layout(v); });
     if (run.backend == "reference" && run.variant != "auto")
         throw InvalidArgument("run option variant: '" + run.variant +
                               "' applies to the CPU back-end; the reference back-end has none");
@@ -45,12 +52,10 @@ std::shared_ptr<const Executor> make_run_executor(const RunOptions& run) {
     validate(run);
     if (!uses_executor(run)) return nullptr;
     const int threads = run.threads > 0 ? run.threads : hardware_threads();
-    ExecutorKind kind = ExecutorKind::Pool;
-    if (run.backend == "serial" || (run.backend == "auto" && threads == 1))
-        kind = ExecutorKind::Serial;
-    else if (run.backend != "auto")
-        kind = parse_executor_kind(run.backend);
     if (run.backend == "auto" && threads == 1 && run.variant == "auto") return nullptr;  // the serial loops
+    const ExecutorKind kind = run.backend != "auto" ? parse_executor_kind(run.backend)
+                              : threads == 1        ? ExecutorKind::Serial
+                                                    : ExecutorKind::Pool;
     auto ex = make_executor(kind, kind == ExecutorKind::Serial ? 1 : threads, parse_schedule(run.schedule));
     return run.adaptive && ex->threads() > 1 ? make_adaptive(std::move(ex)) : ex;
 }

@@ -18,15 +18,18 @@ Scene permute_scene(const Scene& scene, const std::vector<index_t>& new_of_old) 
 }
 
 namespace {
-// The user's array must hold 3 values per vertex: checked, as the C API's
-// counts are, since a short span would be read or written past its end.
+// A user array of `given` values for a state of `expected` (3 #V): checked,
+// as the C API's counts are, since a short span would be read or written
+// past its end.
+void check_length(std::size_t given, std::size_t expected) {
+    if (given != expected)
+        throw InvalidArgument("expected 3 x #V = " + std::to_string(expected) + " values (one xyz per vertex), got " +
+                              std::to_string(given));
+}
+
 template <class From, class To>
 void gather(std::span<const From> in, std::span<To> out, const std::vector<index_t>& new_of_old, bool to_internal_order) {
-    const std::size_t n = 3 * new_of_old.size();
-    const std::size_t given = to_internal_order ? in.size() : out.size();
-    if (given != n)
-        throw InvalidArgument("expected 3 x #V = " + std::to_string(n) + " values (one xyz per vertex), got " +
-                              std::to_string(given));
+    check_length(to_internal_order ? in.size() : out.size(), 3 * new_of_old.size());
     for (std::size_t v = 0; v < new_of_old.size(); ++v)
         for (int r = 0; r < 3; ++r) {
             const std::size_t user = 3 * v + r, internal = 3 * std::size_t(new_of_old[v]) + r;
@@ -134,12 +137,6 @@ Energies OrderedSimulator<S>::energies() {
 }
 
 namespace {
-// A user array of `given` values for a view of `expected` (3 #V).
-void check_length(std::size_t given, std::size_t expected) {
-    if (given != expected)
-        throw InvalidArgument("expected 3 x #V = " + std::to_string(expected) + " values (one xyz per vertex), got " +
-                              std::to_string(given));
-}
 template <class From, class To>
 void copy_into_user(std::span<const From> view, std::span<To> out) {
     check_length(out.size(), view.size());
