@@ -49,6 +49,8 @@ __global__ void tet_formulas(int n, const S* u, const S* dinv, S* out) {
     physics::TetStiffnessTerms<S> k;
     physics::tet_stiffness_terms<S>(d, Dinv, S(1), S(2), k);
     physics::tet_stiffness_times<S>(d, U, Dinv, S(1), S(2), y);
+    S Kt[90];
+    physics::tet_stiffness_blocks(k, Kt);
     // The tet-local form on the same tet's "edge vectors".
     S p[6][3], W[6][4][3], kv[9], zeta[6];
     for (int e = 0; e < 6; ++e) {
@@ -61,7 +63,7 @@ __global__ void tet_formulas(int n, const S* u, const S* dinv, S* out) {
     const auto coef = [&](int a, int b) { return a == b ? S(0) : Dinv[a % 3][b % 3]; };
     physics::form_w<S>(coef, p, W);
     physics::form_block<S>(t % 6, p, W, kv);
-    out[t] = d.energy + f[0][0] + y[1][2] + physics::tet_stiffness_entry(k, 0, 1, 2, 0) + kv[4] + physics::form_g(t % 6, coef, zeta);
+    out[t] = d.energy + f[0][0] + y[1][2] + physics::tet_stiffness_entry(k, 0, 1, 2, 0) + Kt[t % 90] + kv[4] + physics::form_g(t % 6, coef, zeta);
 }
 
 template __global__ void edge_formulas<double>(int, const double*, const double*, const double*, double*);

@@ -146,7 +146,7 @@ template <class S>
 class ReferenceTetOperator final : public ElasticOperator<S> {
 public:
     ReferenceTetOperator(const Mesh& mesh, const Materials& materials)
-        : mesh_(mesh), m_(make_tet_model<S>(mesh, materials)), u_(mesh.X.size()), scratch_(mesh.X.size()) {}
+        : mesh_(mesh), m_(make_tet_model<S>(mesh, materials)), u_(mesh.X.size()) {}
     index_t num_vertices() const override { return m_.num_vertices; }
     double forces(const S* u, S* f, bool energy) override {
         std::copy(u, u + u_.size(), u_.begin());
@@ -173,12 +173,7 @@ public:
             const physics::TetDeformation<S> d = deformation(t, u_.data());
             physics::TetStiffnessTerms<S> k;
             physics::tet_stiffness_terms<S>(d, m_.data[t].Dinv, m_.data[t].vol_lambda, m_.data[t].vol_mu, k);
-            S* Kt = &K_[90 * std::size_t(t)];
-            for (int i = 0; i < 4; ++i)
-                for (int j = i; j < 4; ++j)
-                    for (int r = 0; r < 3; ++r)
-                        for (int c = 0; c < 3; ++c)
-                            Kt[9 * physics::tet_block_index(i, j) + 3 * r + c] = physics::tet_stiffness_entry(k, i, j, r, c);
+            physics::tet_stiffness_blocks(k, &K_[90 * std::size_t(t)]);
         }
     }
     void multiply(const S* x, S* y) const override {
@@ -219,7 +214,7 @@ private:
     const Mesh& mesh_;
     TetModel<S> m_;
     std::vector<S> K_;  // 90 #T
-    std::vector<S> u_, scratch_;
+    std::vector<S> u_;  // u of the last forces() call
     mutable std::vector<double> positions_;
 };
 

@@ -65,10 +65,7 @@ EDGEFEM_KERNEL void tet_stiffness(const TetModel<S>& m, index_t t, const S* __re
     const auto& d = m.data[t];
     physics::TetStiffnessTerms<S> k;
     physics::tet_stiffness_terms<S>(def, d.Dinv, d.vol_lambda, d.vol_mu, k);
-    for (int i = 0; i < 4; ++i)
-        for (int j = i; j < 4; ++j)
-            for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c) Kt[9 * tet_block_index(i, j) + 3 * r + c] = physics::tet_stiffness_entry(k, i, j, r, c);
+    physics::tet_stiffness_blocks(k, Kt);
 }
 
 // y += K_t x for one tet from its stored blocks. Built-in scalars: each

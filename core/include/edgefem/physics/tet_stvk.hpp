@@ -143,6 +143,16 @@ EDGEFEM_FORMULA T tet_stiffness_entry(const TetStiffnessTerms<T>& k, int i, int 
     return v;
 }
 
+// The 10 distinct blocks (i <= j, tet_block_index order, each row-major)
+// into Kt[0..89].
+template <class T>
+EDGEFEM_FORMULA void tet_stiffness_blocks(const TetStiffnessTerms<T>& k, T* Kt) {
+    for (int i = 0; i < 4; ++i)
+        for (int j = i; j < 4; ++j)
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) Kt[9 * tet_block_index(i, j) + 3 * r + c] = tet_stiffness_entry(k, i, j, r, c);
+}
+
 // The K x of one tet without stored blocks, for a direction x given per
 // vertex (X): dF = dX Dm^-1, dP = dF S + F dS, dy = the nodal vectors of dP
 // (overwritten).
