@@ -1,5 +1,7 @@
 #include "edgefem/core/mesh.hpp"
 
+#include "edgefem/physics/tet_volume.hpp"
+
 namespace edgefem {
 
 namespace {
@@ -27,12 +29,7 @@ std::string Mesh::describe_vertex(index_t v) const {
 }
 
 double signed_volume(const double* a, const double* b, const double* c, const double* d) {
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-            u[2] * (v[0] * w[1] - v[1] * w[0])) /
-           6.0;
+    return physics::tet_signed_volume(a, b, c, d);
 }
 
 }  // namespace edgefem

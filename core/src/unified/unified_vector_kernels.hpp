@@ -28,27 +28,27 @@ public:
     explicit UnifiedVectorKernels(Launch launch) : launch_(std::move(launch)) {}
 
     void fill(double* x, std::size_t n, double value) const override {
-        launch_.each(n, [=](std::size_t i) { x[i] = value; });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { x[i] = value; });
     }
     void fill_state(S* x, std::size_t n, S value) const override {
-        launch_.each(n, [=](std::size_t i) { x[i] = value; });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { x[i] = value; });
     }
     void copy(double* dst, const double* src, std::size_t n) const override { copy_any(dst, src, n); }
     void copy_state(S* dst, const S* src, std::size_t n) const override { copy_any(dst, src, n); }
     void to_state(S* dst, const double* src, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) { dst[i] = S(src[i]); });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { dst[i] = S(src[i]); });
     }
     void from_state(double* dst, const S* src, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) { dst[i] = double(src[i]); });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { dst[i] = double(src[i]); });
     }
     void rescale(double* a, double* b, std::size_t n, double s, bool divide) const override {
         if (divide)
-            launch_.each(n, [=](std::size_t i) {
+            launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
                 a[i] /= s;
                 b[i] /= s;
             });
         else
-            launch_.each(n, [=](std::size_t i) {
+            launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
                 a[i] *= s;
                 b[i] *= s;
             });
@@ -56,57 +56,57 @@ public:
 
     void external_load(double* h, const S* fext, const double* mass, const std::array<double, 3>& g, double load,
                        std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) { h[i] = ops::external_load(load, mass[i / 3], g[i % 3], double(fext[i])); });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { h[i] = ops::external_load(load, mass[i / 3], g[i % 3], double(fext[i])); });
     }
     void explicit_velocity(double* x, const S* v, const double* h, const S* f, const double* mass, double T,
                            double damp, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
             x[i] = ops::explicit_velocity(double(v[i]), T, h[i], double(f[i]), mass[i / 3], damp);
         });
     }
     void semi_implicit_rhs(double* b, double* x, const S* v, const double* h, const S* f, const double* mass,
                            double T, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
             b[i] = ops::semi_implicit_rhs(mass[i / 3], double(v[i]), T, h[i], double(f[i]));
             x[i] = double(v[i]);
         });
     }
     void take_velocity(S* u, S* v, const double* x, double T, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
             v[i] = S(x[i]);
             u[i] += S(T * x[i]);
         });
     }
     void implicit_predict(double* u0, double* upred, const S* u, const S* v, double T, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
             u0[i] = double(u[i]);
             upred[i] = ops::axpy(u0[i], T, double(v[i]));
         });
     }
     void implicit_velocity(S* v, const S* u, const double* u0, double T, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) { v[i] = S(ops::difference_quotient(double(u[i]), u0[i], T)); });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { v[i] = S(ops::difference_quotient(double(u[i]), u0[i], T)); });
     }
     void newton_increment(double* d, const S* u, const double* u0, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) { d[i] = double(u[i]) - (u0 ? u0[i] : 0.0); });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { d[i] = double(u[i]) - (u0 ? u0[i] : 0.0); });
     }
     void newton_rhs(double* b, double* x, const double* R, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
             b[i] = -R[i];
             x[i] = 0;
         });
     }
     void scaled_gradient(double* x, const double* R, const double* mass, double c, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) { x[i] = -R[i] / (mass[i / 3] * c); });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { x[i] = -R[i] / (mass[i / 3] * c); });
     }
     void line_search_point(S* u, const double* u_start, const double* du, double step, std::size_t n) const override {
-        launch_.each(n, [=](std::size_t i) { u[i] = S(ops::axpy(u_start[i], step, du[i])); });
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { u[i] = S(ops::axpy(u_start[i], step, du[i])); });
     }
 
     void constrained_velocities(double* vel, const S* u, const ConstraintView& c, double fraction,
                                 double T) const override {
         const index_t* vertex = c.vertex;
         const double* disp = c.disp;
-        launch_.each(3 * c.count, [=](std::size_t j) {
+        launch_.each(3 * c.count, [=] EDGEFEM_LAMBDA(std::size_t j) {
             const std::size_t i = 3 * std::size_t(vertex[j / 3]) + j % 3;
             vel[i] = ops::constrained_velocity(fraction, disp[j], double(u[i]), T);
         });
@@ -114,25 +114,25 @@ public:
     void hold_constraints(S* u, const ConstraintView& c, double fraction) const override {
         const index_t* vertex = c.vertex;
         const double* disp = c.disp;
-        launch_.each(3 * c.count, [=](std::size_t j) { u[3 * std::size_t(vertex[j / 3]) + j % 3] = S(fraction * disp[j]); });
+        launch_.each(3 * c.count, [=] EDGEFEM_LAMBDA(std::size_t j) { u[3 * std::size_t(vertex[j / 3]) + j % 3] = S(fraction * disp[j]); });
     }
     bool constraints_move(const S* u, const ConstraintView& c, double fraction, double tol) const override {
         const index_t* vertex = c.vertex;
         const double* disp = c.disp;
         return launch_.reduce(
             3 * c.count, false,
-            [=](std::size_t lo, std::size_t hi) {
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
                 for (std::size_t j = lo; j < hi; ++j) {
                     const double target = fraction * disp[j], cur = double(u[3 * std::size_t(vertex[j / 3]) + j % 3]);
                     if (std::abs(target - cur) > tol * (std::abs(target) + std::abs(cur))) return true;
                 }
                 return false;
             },
-            [](bool& any, bool part) { any = any || part; });
+            [] EDGEFEM_LAMBDA(bool& any, bool part) { any = any || part; });
     }
 
     double count_differences(const S* a, const S* b, std::size_t n) const override {
-        return launch_.sum(n, [=](std::size_t i) { return a[i] == b[i] ? 0.0 : 1.0; });
+        return launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) { return a[i] == b[i] ? 0.0 : 1.0; });
     }
     // Per block as interleaved sums over its vertices (a block holds whole
     // vertices). One running sum per term, through the dofs, took 6.5 us
@@ -142,7 +142,7 @@ public:
         const double g0 = g[0], g1 = g[1], g2 = g[2];
         return launch_.reduce(
             n, std::array<double, 3>{},
-            [=](std::size_t lo, std::size_t hi) {
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
                 const std::size_t a0 = lo / 3, a1 = hi / 3;
                 const auto d = [](S x) { return double(x); };
                 // v read before the call: read as its arguments (evaluated in
@@ -157,32 +157,32 @@ public:
                 const double load = Launch::range_sum(lo, hi, [&](std::size_t i) { return d(fext[i]) * d(u[i]); });
                 return std::array<double, 3>{0.5 * kinetic, -gravity, load};
             },
-            add<3>);
+            AddArrays{});
     }
     std::size_t first_non_finite(const S* u, const S* v, std::size_t n) const override {
         return launch_.reduce(
             n, n,
-            [=](std::size_t lo, std::size_t hi) {
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
                 for (std::size_t i = lo; i < hi; ++i)
                     if (!std::isfinite(double(u[i])) || !std::isfinite(double(v[i]))) return i;
                 return n;
             },
-            [](std::size_t& first, std::size_t part) { first = std::min(first, part); });
+            [] EDGEFEM_LAMBDA(std::size_t& first, std::size_t part) { first = std::min(first, part); });
     }
     Scaled scaled_dot(const double* a, const double* b, std::size_t n) const override {
-        return scaled_dot_of([=](std::size_t i) { return a[i]; }, [=](std::size_t i) { return b[i]; }, n);
+        return scaled_dot_of([=] EDGEFEM_LAMBDA(std::size_t i) { return a[i]; }, [=] EDGEFEM_LAMBDA(std::size_t i) { return b[i]; }, n);
     }
     double scaled_norm(const double* a, std::size_t n) const override {
-        return norm_of(scaled_dot_of([=](std::size_t i) { return a[i]; }, [=](std::size_t i) { return a[i]; }, n));
+        return norm_of(scaled_dot_of([=] EDGEFEM_LAMBDA(std::size_t i) { return a[i]; }, [=] EDGEFEM_LAMBDA(std::size_t i) { return a[i]; }, n));
     }
     double scaled_norm_state(const S* a, std::size_t n) const override {
-        const auto term = [=](std::size_t i) { return double(a[i]); };
+        const auto term = [=] EDGEFEM_LAMBDA(std::size_t i) { return double(a[i]); };
         return norm_of(scaled_dot_of(term, term, n));
     }
     std::array<double, 4> newton_residual(const NewtonResidualArgs<S>& a, std::size_t n) const override {
         return launch_.reduce(
             n, std::array<double, 4>{},
-            [=](std::size_t lo, std::size_t hi) {
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
                 std::array<double, 4> acc{};
                 for (std::size_t i = lo; i < hi; ++i) {
                     const double u = double(a.u[i]);
@@ -200,13 +200,13 @@ public:
                 }
                 return acc;
             },
-            add<4>);
+            AddArrays{});
     }
     std::array<double, 3> solve_magnitudes(const double* b, const double* x, const double* mass_dof,
                                            const std::uint8_t* free_dof, std::size_t n) const override {
         return launch_.reduce(
             n, std::array<double, 3>{},
-            [=](std::size_t lo, std::size_t hi) {
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
                 double bm = 0, xm = 0, mm = 0;
                 for (std::size_t i = lo; i < hi; ++i) {
                     if (free_dof[i]) bm = std::max(bm, std::abs(b[i]));
@@ -215,7 +215,7 @@ public:
                 }
                 return std::array<double, 3>{bm, xm, mm};
             },
-            [](std::array<double, 3>& m, const std::array<double, 3>& p) {
+            [] EDGEFEM_LAMBDA(std::array<double, 3>& m, const std::array<double, 3>& p) {
                 for (int k = 0; k < 3; ++k) m[k] = std::max(m[k], p[k]);
             });
     }
@@ -227,13 +227,13 @@ public:
     }
     void system_diagonal(std::size_t n, double c_m, double c_k, double c_b, const double* mass_dof, const double* in,
                          const double* K0in, double* out) const override {
-        launch_.blocks(n, [=](std::size_t lo, std::size_t hi) {
+        launch_.blocks(n, [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
             diagonal_range(lo, hi, c_m, c_k, c_b, mass_dof, in, K0in, out);
         });
     }
     void block_jacobi_build(double* Dinv, const S* D, const S* D0, const double* mass, double c_m, double c_k,
                             double c_b, std::size_t n) const override {
-        launch_.each_vertex(n, [=](std::size_t v) {
+        launch_.each_vertex(n, [=] EDGEFEM_LAMBDA(std::size_t v) {
             ops::block_jacobi_inverse(D + 9 * v, c_b != 0 ? D0 + 9 * v : nullptr, mass[v], c_m, c_k, c_b,
                                       Dinv + 9 * v);
         });
@@ -246,21 +246,24 @@ public:
         for (std::size_t v = lo / 3; v < hi / 3; ++v) ops::block_jacobi_apply(&Minv[9 * v], &r[3 * v], &z[3 * v]);
     }
 
-protected:
-    Launch launch_;
-
-private:
+    // The helpers below are public only because nvcc's extended lambdas
+    // may not sit in a private or protected member function.
     template <class T>
     void copy_any(T* dst, const T* src, std::size_t n) const {
-        launch_.blocks(n, [=](std::size_t lo, std::size_t hi) { std::copy(src + lo, src + hi, dst + lo); });
+        launch_.blocks(n, [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
+            for (std::size_t i = lo; i < hi; ++i) dst[i] = src[i];
+        });
     }
-    template <std::size_t K>
-    static void add(std::array<double, K>& s, const std::array<double, K>& p) {
-        for (std::size_t k = 0; k < K; ++k) s[k] += p[k];
-    }
+    // Element-wise sums of arrays (reduce's combine).
+    struct AddArrays {
+        template <std::size_t K>
+        EDGEFEM_HOST_DEVICE void operator()(std::array<double, K>& s, const std::array<double, K>& p) const {
+            for (std::size_t k = 0; k < K; ++k) s[k] += p[k];
+        }
+    };
     // Scalars by value and the arrays through local restrict pointers: the
     // loops vectorise.
-    static void diagonal_range(std::size_t lo, std::size_t hi, double c_m, double c_k, double c_b,
+    EDGEFEM_HOST_DEVICE static void diagonal_range(std::size_t lo, std::size_t hi, double c_m, double c_k, double c_b,
                                const double* mass_dof, const double* in, const double* K0in, double* out) {
         const double* __restrict m = mass_dof;
         const double* __restrict xin = in;
@@ -277,7 +280,7 @@ private:
     std::array<double, 2> max_exponent(Term term, std::size_t n) const {
         const std::array<double, 2> m = launch_.reduce(
             n, std::array<double, 2>{},
-            [=](std::size_t lo, std::size_t hi) {
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
                 double mx = 0, b = 0;
                 for (std::size_t i = lo; i < hi; ++i) {
                     const double t = std::abs(term(i));
@@ -286,7 +289,7 @@ private:
                 }
                 return std::array<double, 2>{mx, b};
             },
-            [](std::array<double, 2>& acc, const std::array<double, 2>& p) {
+            [] EDGEFEM_LAMBDA(std::array<double, 2>& acc, const std::array<double, 2>& p) {
                 if (p[1] != 0) acc[1] = p[1];
                 acc[0] = std::max(acc[0], p[0]);
             });
@@ -298,11 +301,14 @@ private:
         const double bad = xb[1] != 0 ? xb[1] : xa[1];
         if (bad != 0) return {bad, 0};
         const int ea = int(xa[0]), eb = int(xb[0]);
-        return {launch_.sum(n, [=](std::size_t i) { return std::ldexp(a(i), -ea) * std::ldexp(b(i), -eb); }), ea + eb};
+        return {launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) { return std::ldexp(a(i), -ea) * std::ldexp(b(i), -eb); }), ea + eb};
     }
     static double norm_of(const Scaled& s) {
         return std::isfinite(s.mant) ? std::ldexp(std::sqrt(s.mant), s.exp / 2) : s.mant;
     }
+
+protected:
+    Launch launch_;
 };
 
 }  // namespace edgefem
