@@ -53,9 +53,14 @@ std::vector<index_t> non_identity(std::vector<index_t> new_of_old) {
 template <class S>
 OrderedSimulator<S>::OrderedSimulator(const Scene& scene, Ordering ordering, std::shared_ptr<const Executor> executor,
                                       OperatorFactory<S> factory, const OrderingOptions& options)
+    : OrderedSimulator(scene, ordering, make_cpu_backend<S>(std::move(executor), std::move(factory)), options) {}
+
+template <class S>
+OrderedSimulator<S>::OrderedSimulator(const Scene& scene, Ordering ordering, std::shared_ptr<const Backend<S>> backend,
+                                      const OrderingOptions& options)
     : user_scene_((scene.validate(), scene)),
       new_of_old_(non_identity(vertex_ordering(scene.mesh, ordering, options))),
-      sim_(identity() ? scene : permute_scene(scene, new_of_old_), std::move(executor), std::move(factory)) {
+      sim_(identity() ? scene : permute_scene(scene, new_of_old_), std::move(backend)) {
     if (identity()) return;
     const std::size_t n = 3 * new_of_old_.size();
     u_.assign(n, S(0));

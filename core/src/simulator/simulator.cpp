@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "integrators/static_solve.hpp"
+#include "simulator/host_views.hpp"
 #include "integrators/time_integrator.hpp"
 #include "simulator/step_control.hpp"
 
@@ -18,6 +19,7 @@ struct Simulator<S>::Impl {
     sim::TangentSolve<S> solve;
     std::unique_ptr<sim::TimeIntegrator<S>> integrator;
     sim::StepControl<S> control;
+    sim::HostViews<S> views;
 
     Impl(Scene scene, std::shared_ptr<const Backend<S>> backend)
         : state(std::move(scene), std::move(backend)),
@@ -27,7 +29,20 @@ struct Simulator<S>::Impl {
         if (!integrator->builds_stiffness()) state.op->keep_state(false);
     }
 
+    // Runs `call` on the state: the written views synced in first, the
+    // views' copies stale after (also when it throws).
+    template <class Call>
+    decltype(auto) on_state(Call&& call) {
+        views.sync();
+        struct Changed {
+            const sim::HostViews<S>& v;
+            ~Changed() { v.changed(); }
+        } changed{views};
+        return call();
+    }
+
     Energies energies() {
+        views.sync();
         const auto& s = state;
         Energies e;
         e.elastic = s.op->energy(s.u.data());
@@ -70,31 +85,33 @@ index_t Simulator<S>::num_vertices() const {
 }
 template <class S>
 const StepStats& Simulator<S>::step() {
-    return self().control.step();
+    Impl& m = self();
+    return m.on_state([&]() -> const StepStats& { return m.control.step(); });
 }
 template <class S>
 StaticResult Simulator<S>::solve_static() {
+    Impl& m = self();
     try {
-        return sim::solve_static(self().state, self().solve);
+        return m.on_state([&] { return sim::solve_static(m.state, m.solve); });
     } catch (const sim::StepFailure& failure) {
         throw SimulationError("static solve: " + failure.message, self().state.step, failure.vertex);
     }
 }
 template <class S>
 std::span<S> Simulator<S>::displacement() {
-    return self().state.u.host();
+    return self().views.writable(self().state.u, sim::HostViews<S>::U);
 }
 template <class S>
 std::span<S> Simulator<S>::velocity() {
-    return self().state.v.host();
+    return self().views.writable(self().state.v, sim::HostViews<S>::V);
 }
 template <class S>
 std::span<S> Simulator<S>::external_forces() {
-    return self().state.fext.host();
+    return self().views.writable(self().state.fext, sim::HostViews<S>::Fext);
 }
 template <class S>
 std::span<const S> Simulator<S>::forces() const {
-    return std::as_const(self().state.f).host();
+    return self().views.readable(self().state.f, sim::HostViews<S>::F);
 }
 template <class S>
 std::span<const double> Simulator<S>::lumped_mass() const {
@@ -102,6 +119,7 @@ std::span<const double> Simulator<S>::lumped_mass() const {
 }
 template <class S>
 std::vector<double> Simulator<S>::positions() const {
+    self().views.sync();
     const auto& s = self().state;
     std::vector<S> u_copy;
     const std::span<const S> u = s.u.read_host(u_copy);

@@ -95,8 +95,10 @@ public:
     // steps hold the prescribed vertices at their targets.
     StaticResult solve_static();
 
-    // Zero-copy views (3 #V, xyz per vertex) of the back-end's vectors (Error
-    // for a back-end without host memory). External forces are the
+    // Views (3 #V, xyz per vertex) of the back-end's vectors: zero-copy in
+    // host memory; for a GPU back-end a host copy made when first asked for
+    // after a step and, for the writable ones, copied back at the next
+    // step (a view stays valid until the next step()). External forces are the
     // application's to change between steps (e.g. a haptic probe); forces()
     // holds the internal elastic forces of the last evaluation.
     std::span<S> displacement();

@@ -27,6 +27,9 @@ class OrderedSimulator {
 public:
     OrderedSimulator(const Scene& scene, Ordering ordering, std::shared_ptr<const Executor> executor = nullptr,
                      OperatorFactory<S> factory = {}, const OrderingOptions& options = {});
+    // On any back-end (backend.hpp).
+    OrderedSimulator(const Scene& scene, Ordering ordering, std::shared_ptr<const Backend<S>> backend,
+                     const OrderingOptions& options = {});
 
     // A SimulationError names its vertex in the user's numbering (vertex()
     // and the message's "vertex N").
