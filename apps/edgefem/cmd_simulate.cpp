@@ -83,8 +83,8 @@ void run_simulate(const SimulateOptions& opts) {
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
     const auto executor = make_run_executor(opts.run);
-    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering), executor,
-                                  operator_factory<double>(opts.run, executor));
+    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering),
+                                  make_run_backend<double>(opts.run, executor));
     Simulator<double>& sim = osim.internal();
     const Scene& scene = sf.scene;  // the user's numbering
     const long steps = scene.steps;

@@ -26,8 +26,8 @@ void run_static(const StaticOptions& opts) {
     check_writable("--out", opts.out + ".vtu");
     SceneFile sf = load_scene_file(opts.scene);
     const auto executor = make_run_executor(opts.run);
-    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering), executor,
-                                  operator_factory<double>(opts.run, executor));
+    OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering),
+                                  make_run_backend<double>(opts.run, executor));
     const Simulator<double>& sim = osim.internal();
     const StaticResult r = osim.solve_static();
 

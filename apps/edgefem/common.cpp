@@ -168,9 +168,10 @@ void add_run_options(CLI::App& cmd, RunOptions& opts, bool with_variant) {
     cmd.add_option("--backend", opts.backend,
                    "Where the kernels run: auto (every core: the pool back-end, or serial on one core), serial "
                    "(the CPU back-end's loops on one thread), omp (OpenMP), tbb (oneTBB), pool (std::threads that "
-                   "spin between calls: no system call per call) or reference (plain loops, the tests' oracle; "
-                   "slow) (docs/parallel.md, \"Back-ends\")")
-        ->check(CLI::IsMember({"auto", "serial", "omp", "tbb", "pool", "reference"}))
+                   "spin between calls: no system call per call), reference (plain loops, the tests' oracle; "
+                   "slow) or cuda (the NVIDIA GPU back-end: simulate and static; an error where the build or "
+                   "the machine has no CUDA) (docs/parallel.md, \"Back-ends\")")
+        ->check(CLI::IsMember({"auto", "serial", "omp", "tbb", "pool", "reference", "cuda"}))
         ->capture_default_str();
     cmd.add_option("--threads", opts.threads, "Threads of the auto/omp/tbb/pool back-end (0: all hardware threads)")
         ->check(int_in_range(0))

@@ -4,6 +4,7 @@
 #include "edgefem/core/reference_operator.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"
+#include "edgefem/parallel/cuda_backend.hpp"
 #include "edgefem/parallel/executors.hpp"
 
 namespace edgefem {
@@ -21,19 +22,19 @@ void check_option(const char* option, const std::string& value, Parse&& parse) {
 }
 
 bool uses_executor(const RunOptions& run) {
-    return run.backend != "reference" && !(run.backend == "serial" && run.variant == "auto");
+    return run.backend != "reference" && run.backend != "cuda" && !(run.backend == "serial" && run.variant == "auto");
 }
 
 }  // namespace
 
 void validate(const RunOptions& run) {
-    // auto and reference, then the executors' kinds.
-    if (run.backend != "auto" && run.backend != "reference")
+    // auto, reference and cuda, then the executors' kinds.
+    if (run.backend != "auto" && run.backend != "reference" && run.backend != "cuda")
         check_option("backend", run.backend, [](const std::string& b) {
             try {
                 parse_executor_kind(b);
             } catch (const InvalidArgument&) {
-                throw InvalidArgument("unknown value '" + b + "' (expected auto, reference, serial, omp, tbb or pool)");
+                throw InvalidArgument("unknown value '" + b + "' (expected auto, reference, serial, omp, tbb, pool or cuda)");
             }
         });
     if (run.threads < 0 || run.threads > kMaxThreads)
@@ -43,9 +44,9 @@ void validate(const RunOptions& run) {
     check_option("schedule", run.schedule, [](const std::string& v) { parse_schedule(v); });
     check_option("ordering", run.ordering, [](const std::string& v) { parse_ordering(v); });
     check_option("layout", run.layout, [](const std::string& v) { parse_stiffness_layout(v); });
-    if (run.backend == "reference" && run.variant != "auto")
-        throw InvalidArgument("run option variant: '" + run.variant +
-                              "' applies to the CPU back-end; the reference back-end has none");
+    if ((run.backend == "reference" || run.backend == "cuda") && run.variant != "auto")
+        throw InvalidArgument("run option variant: '" + run.variant + "' applies to the CPU back-end; the " +
+                              run.backend + " back-end has none");
 }
 
 std::shared_ptr<const Executor> make_run_executor(const RunOptions& run) {
@@ -63,6 +64,9 @@ std::shared_ptr<const Executor> make_run_executor(const RunOptions& run) {
 template <class S>
 OperatorFactory<S> make_run_factory(const RunOptions& run, std::shared_ptr<const Executor> executor) {
     validate(run);
+    if (run.backend == "cuda")
+        throw InvalidArgument("run option backend: cuda runs whole simulations (make_run_backend, make_simulator); "
+                              "its operators work on device vectors, not on host arrays");
     if (run.backend == "reference")
         return [](const Mesh& mesh, const Materials& materials, ModelKind model, Method method) {
             return make_reference_operator<S>(mesh, materials, model, method);
@@ -71,14 +75,22 @@ OperatorFactory<S> make_run_factory(const RunOptions& run, std::shared_ptr<const
 }
 
 template <class S>
+std::shared_ptr<const Backend<S>> make_run_backend(const RunOptions& run, std::shared_ptr<const Executor> executor) {
+    validate(run);
+    if (run.backend == "cuda") return make_cuda_backend<S>();
+    auto factory = make_run_factory<S>(run, executor);
+    return make_cpu_backend<S>(std::move(executor), std::move(factory));
+}
+
+template <class S>
 std::unique_ptr<OrderedSimulator<S>> make_simulator(const Scene& scene, const RunOptions& run) {
     auto ex = make_run_executor(run);
-    auto factory = make_run_factory<S>(run, ex);
-    return std::make_unique<OrderedSimulator<S>>(scene, parse_ordering(run.ordering), std::move(ex), std::move(factory));
+    return std::make_unique<OrderedSimulator<S>>(scene, parse_ordering(run.ordering), make_run_backend<S>(run, ex));
 }
 
 std::string describe(const RunOptions& run, const Executor* executor) {
     if (run.backend == "reference") return "reference";
+    if (run.backend == "cuda") return "cuda (" + cuda_device_description() + ")";
     if (!executor) return "serial";
     std::string name = executor->name();
     if (const auto* a = dynamic_cast<const AdaptiveExecutor*>(executor)) name = a->inner().name();
@@ -88,6 +100,9 @@ std::string describe(const RunOptions& run, const Executor* executor) {
 
 template OperatorFactory<double> make_run_factory<double>(const RunOptions&, std::shared_ptr<const Executor>);
 template OperatorFactory<float> make_run_factory<float>(const RunOptions&, std::shared_ptr<const Executor>);
+template std::shared_ptr<const Backend<double>> make_run_backend<double>(const RunOptions&,
+                                                                           std::shared_ptr<const Executor>);
+template std::shared_ptr<const Backend<float>> make_run_backend<float>(const RunOptions&, std::shared_ptr<const Executor>);
 template std::unique_ptr<OrderedSimulator<double>> make_simulator<double>(const Scene&, const RunOptions&);
 template std::unique_ptr<OrderedSimulator<float>> make_simulator<float>(const Scene&, const RunOptions&);
 

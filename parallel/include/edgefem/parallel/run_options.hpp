@@ -27,7 +27,9 @@ struct RunOptions {
     // reference: the reference back-end (plain serial loops, the oracle; slow);
     // serial: the CPU back-end's serial loops (one thread);
     // omp, tbb, pool: the CPU back-end's threaded kernels on OpenMP, oneTBB or
-    //   the spinning thread pool.
+    //   the spinning thread pool;
+    // cuda: the GPU back-end (cuda_backend.hpp; an error naming the reason
+    //   where it cannot run: a build without CUDA, no device).
     std::string backend = "auto";
     // Threads of auto/omp/tbb/pool; 0: every hardware thread.
     int threads = 0;
@@ -53,7 +55,7 @@ struct RunOptions {
 void validate(const RunOptions& run);
 
 // The executor the solvers' vector work and the threaded kernels run on:
-// null for reference and serial (without a variant), else the chosen one,
+// null for reference, cuda and serial (without a variant), else the chosen one,
 // wrapped in an AdaptiveExecutor when run.adaptive.
 std::shared_ptr<const Executor> make_run_executor(const RunOptions& run);
 
@@ -62,12 +64,18 @@ std::shared_ptr<const Executor> make_run_executor(const RunOptions& run);
 template <class S>
 OperatorFactory<S> make_run_factory(const RunOptions& run, std::shared_ptr<const Executor> executor);
 
+// The back-end the options describe: the CUDA back-end for cuda, else the
+// CPU back-end (reference: the reference operator) on `executor`.
+template <class S>
+std::shared_ptr<const Backend<S>> make_run_backend(const RunOptions& run, std::shared_ptr<const Executor> executor);
+
 // The simulator the options describe (validated first): renumbered by
 // run.ordering, every vertex array in the scene's own numbering.
 template <class S>
 std::unique_ptr<OrderedSimulator<S>> make_simulator(const Scene& scene, const RunOptions& run = {});
 
-// "pool x2, auto, adaptive" and the like (executor: make_run_executor's).
+// "pool x2, auto, adaptive", "cuda (NVIDIA H100 ...)" and the like
+// (executor: make_run_executor's).
 std::string describe(const RunOptions& run, const Executor* executor);
 
 }  // namespace edgefem

@@ -1,0 +1,33 @@
+// The NVIDIA GPU back-end: model data, state vectors, K blocks and the
+// solvers' vectors live on the device; one step runs there without copying
+// a vector to or from the host (a scalar comes back per reduction). Scatters
+// are gathers over adjacency lists and reductions run in an order fixed by
+// the problem size, so two runs on the same GPU give the same bits.
+//
+// Built when CMake finds nvcc >= 12 (option EDGEFEM_CUDA, AUTO by default);
+// in a build without it, or on a machine without a usable GPU,
+// make_cuda_backend throws Error with the reason.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "edgefem/core/backend.hpp"
+
+namespace edgefem {
+
+// Whether this build has the CUDA back-end.
+bool cuda_built();
+// Empty when the CUDA back-end can run here; else why not (no CUDA in this
+// build, no device, a driver error).
+std::string cuda_unavailable_reason();
+// "NVIDIA H100 80GB HBM3 (sm_90, driver 13.0)" or similar; empty when
+// unavailable.
+std::string cuda_device_description();
+
+// The back-end on the current CUDA device. Throws Error naming the reason
+// when it cannot run.
+template <class S>
+std::shared_ptr<const Backend<S>> make_cuda_backend();
+
+}  // namespace edgefem

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# The GPU check of the CUDA back-end (docs/gpu.md): the GPU tests, the GPU
+# benchmarks and the CPU thread sweep of the same machine, in one log
+# ($OUT/gpu-check.log when OUT is set, else ./gpu-check.log). Under 8
+# minutes on 16 cores and one H100.
+#
+#   scripts/gpu-check.sh          on a GPU machine with the project's
+#                                 dependencies: builds build-gpu/ with CUDA,
+#                                 then runs the check;
+#   scripts/gpu-check.sh pack     on a machine without a GPU (nvcc needed):
+#                                 a portable CUDA build of the programs the
+#                                 check runs, their Debian shared libraries
+#                                 and the meshes, in .gpubundle/ (git-ignored);
+#   .gpubundle/run.sh             on a GPU machine without the dependencies
+#                                 (a lent machine with nothing installed):
+#                                 the check from the bundle.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+PROGRAMS="edgefem edgefem_test_cuda_backend edgefem_bench_gpu"
+mesh_dir=${EDGEFEM_MESH_DIR:-../shared/meshes}
+
+# The check itself: $1 runs a program of the build ($1 NAME ARGS...).
+check() {
+    local X=$1
+    echo "== gpu-check $(date -u +%FT%TZ)"
+    nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv 2>&1 | head -3
+    nvcc --version 2>/dev/null | tail -1
+    echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2) x $(nproc)"
+    echo "== GPU tests"
+    timeout 300 $X edgefem_test_cuda_backend --gtest_brief=0 2>&1 | tail -40
+    echo "tests rc=${PIPESTATUS[0]}"
+    echo "== GPU benchmarks"
+    timeout 150 $X edgefem_bench_gpu --meshes armadillo-7k,bunny-250k,bunny-1m 2>&1
+    echo "bench rc=$?"
+    echo "== CPU sweep: semi-implicit step, 20 CG iterations, bunny-250k"
+    for t in 1 2 4 8 16; do
+        echo "-- threads $t"
+        timeout 40 $X edgefem bench bunny-250k --kernel step --cg-iters 20 --backend pool --threads "$t" --seconds 3 2>&1 \
+            | grep -E "median_ms|min_ms|backend" || true
+    done
+    echo "== gpu-check done $(date -u +%FT%TZ)"
+}
+
+log=${OUT:-.}/gpu-check.log
+case "${1:-build}" in
+build)
+    cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DEDGEFEM_CUDA=ON -DEDGEFEM_NATIVE=OFF >/dev/null || exit 1
+    cmake --build build-gpu -j "$(nproc)" --target $PROGRAMS >/dev/null || exit 1
+    export EDGEFEM_MESH_DIR=$mesh_dir
+    run_built() { local p=$1; shift; "build-gpu/bin/$p" "$@"; }
+    check run_built 2>&1 | tee "$log"
+    ;;
+pack)
+    B=.gpubundle
+    grep -qs "^/$B/" .git/info/exclude || { mkdir -p .git/info && echo "/$B/" >> .git/info/exclude; }
+    cmake -S . -B build-gpubundle -DCMAKE_BUILD_TYPE=Release -DEDGEFEM_CUDA=ON -DEDGEFEM_NATIVE=OFF \
+          -DCMAKE_CXX_FLAGS=-march=x86-64-v3 >/dev/null || exit 1
+    cmake --build build-gpubundle -j "$(nproc)" --target $PROGRAMS || exit 1
+    rm -rf "$B" && mkdir -p "$B/bin" "$B/lib" "$B/meshes"
+    for p in $PROGRAMS; do cp "build-gpubundle/bin/$p" "$B/bin/"; done
+    for l in $(ldd "$B"/bin/* | awk '/=>/ {print $3}' | grep -v libcuda | sort -u) /lib/x86_64-linux-gnu/libtbbmalloc.so.2; do
+        [ -f "$l" ] && cp -L "$l" "$B/lib/"
+    done
+    cp -L /lib64/ld-linux-x86-64.so.2 "$B/lib/"
+    for m in box-1200 spot-2k bunny-4k armadillo-7k bunny-50k armadillo-100k bunny-250k bunny-1m; do
+        for e in node ele; do [ -f "$mesh_dir/$m.$e" ] && gzip -6 -c "$mesh_dir/$m.$e" > "$B/meshes/$m.$e.gz"; done
+    done
+    cp scripts/gpu-check.sh "$B/gpu-check.sh"
+    cat > "$B/run.sh" <<'RUN'
+#!/bin/bash
+# Runs the GPU check from this bundle (scripts/gpu-check.sh pack).
+B=$(cd "$(dirname "$0")" && pwd)
+(cd "$B/meshes" && for f in *.gz; do [ -f "$f" ] && { [ -f "${f%.gz}" ] || gunzip -kf "$f"; }; done)
+export EDGEFEM_MESH_DIR=$B/meshes
+# The driver's libcuda from the machine, everything else from the bundle.
+cuda_dir=$(dirname "$(ldconfig -p | awk '/libcuda.so.1/ {print $NF; exit}')" 2>/dev/null)
+exec bash "$B/gpu-check.sh" bundle "$B" "${cuda_dir:-/usr/lib/x86_64-linux-gnu}"
+RUN
+    chmod +x "$B/run.sh"
+    du -sh "$B"
+    ;;
+bundle)
+    B=$2
+    export B CUDA_LIB=$3
+    run_bundled() { local p=$1; shift; "$B/lib/ld-linux-x86-64.so.2" --library-path "$B/lib:$CUDA_LIB" "$B/bin/$p" "$@"; }
+    check run_bundled 2>&1 | tee "$log"
+    ;;
+*)
+    echo "usage: scripts/gpu-check.sh [build | pack]" >&2
+    exit 2
+    ;;
+esac
