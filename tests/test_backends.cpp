@@ -22,52 +22,20 @@
 #include "edgefem/parallel/cpu_backend.hpp"
 #include "edgefem/parallel/executors.hpp"
 #include "cantilever.hpp"
+#include "operator_outputs.hpp"
 #include "test_meshes.hpp"
 
 using namespace edgefem;
 
 namespace {
 
-const Materials& material() {
-    static const Materials m(Material{1e5, 0.3, 1000});
-    return m;
-}
+using test::direction;
+using test::evaluate;
+using test::expect_close;
+using test::Outputs;
+using test::rel_max;
 
-// |a - b|_max / |b|_max (b the reference).
-double rel_max(const std::vector<double>& a, const std::vector<double>& b) {
-    double d = 0, s = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        d = std::max(d, std::abs(a[i] - b[i]));
-        s = std::max(s, std::abs(b[i]));
-    }
-    return s > 0 ? d / s : d;
-}
-
-// What one operator gives at one configuration, in double.
-struct Outputs {
-    double energy = 0;
-    std::vector<double> f, Kx, Kx_definite, D;
-};
-
-template <class S>
-Outputs evaluate(ElasticOperator<S>& op, const std::vector<double>& u_d, const std::vector<double>& x_d, bool edge) {
-    const std::vector<S> u(u_d.begin(), u_d.end()), x(x_d.begin(), x_d.end());
-    std::vector<S> f(u.size()), y(u.size()), D(3 * u.size());
-    Outputs o;
-    o.energy = op.forces(u.data(), f.data(), true);
-    op.build_stiffness(false);
-    op.multiply(x.data(), y.data());
-    op.diagonal_blocks(D.data());
-    o.f.assign(f.begin(), f.end());
-    o.Kx.assign(y.begin(), y.end());
-    o.D.assign(D.begin(), D.end());
-    if (edge) {
-        op.build_stiffness(true);
-        op.multiply(x.data(), y.data());
-        o.Kx_definite.assign(y.begin(), y.end());
-    }
-    return o;
-}
+const Materials& material() { return test::backend_test_material(); }
 
 struct Config {
     std::string name;
@@ -99,22 +67,6 @@ struct Case {
 constexpr Case kCases[] = {{ModelKind::FE, Method::Edge, "edge-fe"},
                            {ModelKind::SN, Method::Edge, "edge-sn"},
                            {ModelKind::FE, Method::Tet, "tet"}};
-
-void expect_close(const Outputs& got, const Outputs& ref, double tol, const std::string& what) {
-    EXPECT_LE(std::abs(got.energy - ref.energy), tol * std::abs(ref.energy)) << what << " energy";
-    EXPECT_LE(rel_max(got.f, ref.f), tol) << what << " forces";
-    EXPECT_LE(rel_max(got.Kx, ref.Kx), tol) << what << " K x";
-    EXPECT_LE(rel_max(got.D, ref.D), tol) << what << " diagonal blocks";
-    if (!ref.Kx_definite.empty()) {
-        EXPECT_LE(rel_max(got.Kx_definite, ref.Kx_definite), tol) << what << " definite K x";
-    }
-}
-
-std::vector<double> direction(std::size_t n) {
-    std::vector<double> x(n);
-    for (std::size_t i = 0; i < n; ++i) x[i] = std::sin(0.37 * double(i) + 1.0);
-    return x;
-}
 
 }  // namespace
 

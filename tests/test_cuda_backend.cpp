@@ -23,6 +23,7 @@
 #include "cantilever.hpp"
 #include "lab/deformations.hpp"
 #include "models.hpp"
+#include "operator_outputs.hpp"
 #include "test_meshes.hpp"
 
 using namespace edgefem;
@@ -35,76 +36,12 @@ namespace {
         if (!why.empty()) GTEST_SKIP() << "CUDA back-end not tested here: " << why;    \
     } while (0)
 
-const Materials& material() {
-    static const Materials m(Material{1e5, 0.3, 1000});
-    return m;
-}
+using test::evaluate;
+using test::expect_close;
+using test::Outputs;
+using test::rel_max;
 
-double rel_max(const std::vector<double>& a, const std::vector<double>& b) {
-    double d = 0, s = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        d = std::max(d, std::abs(a[i] - b[i]));
-        s = std::max(s, std::abs(b[i]));
-    }
-    return s > 0 ? d / s : d;
-}
-
-struct Outputs {
-    double energy = 0, energy_only = 0;
-    std::vector<double> f, Kx, Kx_definite, D;
-    index_t inverted = 0;
-};
-
-std::vector<double> direction(std::size_t n) {
-    std::vector<double> x(n);
-    for (std::size_t i = 0; i < n; ++i) x[i] = std::sin(0.37 * double(i) + 1.0);
-    return x;
-}
-
-// The operator's outputs, its vectors in `memory` (copied to and from the
-// host around the calls).
-template <class S>
-Outputs evaluate(ElasticOperator<S>& op, const VectorMemory& memory, const std::vector<double>& u_d,
-                 const std::vector<double>& x_d, bool edge) {
-    const std::vector<S> uh(u_d.begin(), u_d.end()), xh(x_d.begin(), x_d.end());
-    BackendVector<S> u(memory, uh.size()), x(memory, xh.size()), f(memory, uh.size()), y(memory, uh.size()),
-        D(memory, 3 * uh.size());
-    u.write(uh);
-    x.write(xh);
-    const auto get = [](const BackendVector<S>& v) {
-        std::vector<S> h(v.size());
-        v.read(h);
-        return std::vector<double>(h.begin(), h.end());
-    };
-    Outputs o;
-    o.energy = op.forces(u.data(), f.data(), true);
-    op.build_stiffness(false);
-    op.multiply(x.data(), y.data());
-    op.diagonal_blocks(D.data());
-    o.f = get(f);
-    o.Kx = get(y);
-    o.D = get(D);
-    if (edge) {
-        op.build_stiffness(true);
-        op.multiply(x.data(), y.data());
-        o.Kx_definite = get(y);
-    }
-    o.energy_only = op.energy(u.data());
-    o.inverted = op.inverted_tets(u.data());
-    return o;
-}
-
-void expect_close(const Outputs& got, const Outputs& ref, double tol, const std::string& what) {
-    EXPECT_LE(std::abs(got.energy - ref.energy), tol * std::abs(ref.energy)) << what << " energy";
-    EXPECT_LE(std::abs(got.energy_only - ref.energy), tol * std::abs(ref.energy)) << what << " energy()";
-    EXPECT_LE(rel_max(got.f, ref.f), tol) << what << " forces";
-    EXPECT_LE(rel_max(got.Kx, ref.Kx), tol) << what << " K x";
-    EXPECT_LE(rel_max(got.D, ref.D), tol) << what << " diagonal blocks";
-    if (!ref.Kx_definite.empty()) {
-        EXPECT_LE(rel_max(got.Kx_definite, ref.Kx_definite), tol) << what << " definite K x";
-    }
-    EXPECT_EQ(got.inverted, ref.inverted) << what << " inverted tets";
-}
+const Materials& material() { return test::backend_test_material(); }
 
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
@@ -150,21 +87,21 @@ TEST(CudaBackend, OperatorsMatchTheReference) {
     for (const auto& nm : test::test_meshes(2000000)) {
         SCOPED_TRACE(nm.name);
         const std::vector<double> u = deformation_displacement(nm.mesh, Deformation::Twist);
-        const std::vector<double> x = direction(u.size());
+        const std::vector<double> x = test::direction(u.size());
         for (const Case& c : kCases) {
             const bool edge = c.method == Method::Edge;
             const auto ref_op = make_reference_operator<double>(nm.mesh, material(), c.model, c.method);
-            const Outputs ref = evaluate(*ref_op, host_memory(), u, x, edge);
+            const Outputs ref = evaluate(*ref_op, u, x, edge);
             auto op = dev->make_operator(nm.mesh, material(), c.model, c.method);
-            const Outputs a = evaluate(*op, dev->memory(), u, x, edge);
+            const Outputs a = evaluate(*op, u, x, edge, dev->memory());
             expect_close(a, ref, 1e-12, std::string(c.name) + " double");
             // Two runs: the same bits (no atomics, fixed reduction order).
             auto op2 = dev->make_operator(nm.mesh, material(), c.model, c.method);
-            const Outputs b = evaluate(*op2, dev->memory(), u, x, edge);
+            const Outputs b = evaluate(*op2, u, x, edge, dev->memory());
             EXPECT_TRUE(same_bits(a.f, b.f) && same_bits(a.Kx, b.Kx) && same_bits(a.D, b.D) && a.energy == b.energy)
                 << c.name << " two runs differ";
             auto opf = devf->make_operator(nm.mesh, material(), c.model, c.method);
-            expect_close(evaluate(*opf, devf->memory(), u, x, edge), ref, 1e-5, std::string(c.name) + " float");
+            expect_close(evaluate(*opf, u, x, edge, devf->memory()), ref, 1e-5, std::string(c.name) + " float");
         }
     }
 }

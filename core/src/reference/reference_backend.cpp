@@ -1,9 +1,8 @@
-// The reference back-end: host memory, the unified vector kernels as plain
-// serial loops in index order, CG as plain passes (plain_cg.hpp), and
-// the reference operator.
+// The reference back-end: host memory, the unified vector kernels (CG
+// included) as plain serial loops in index order, and the reference
+// operator.
 #include "edgefem/core/backend.hpp"
 #include "edgefem/core/reference_operator.hpp"
-#include "reference/plain_cg.hpp"
 #include "reference/serial_launch.hpp"
 #include "unified/unified_vector_kernels.hpp"
 
@@ -15,10 +14,6 @@ template <class S>
 class ReferenceKernels final : public UnifiedVectorKernels<S, SerialLaunch> {
 public:
     ReferenceKernels() : UnifiedVectorKernels<S, SerialLaunch>({}) {}
-    CgResult cg(CgSystem& A, const CgPreconditioner& M, const std::uint8_t* free_dof, const double* b, double* x,
-                std::size_t n, const CgSettings& settings, CgWork& work) const override {
-        return plain_cg(A, M, free_dof, b, x, n, settings, work);
-    }
 };
 
 template <class S>

@@ -18,6 +18,17 @@ __device__ void tet_displacements(const index_t* tet, std::size_t t, const S* u,
         for (int r = 0; r < 3; ++r) U[i][r] = u[3 * std::size_t(tet[4 * t + i]) + r];
 }
 
+// Tet t's deformation at u (with its energy).
+template <class S>
+__device__ physics::TetDeformation<S> deformation(const index_t* tet, const TetData<S>* data, std::size_t t,
+                                                  const S* u) {
+    S U[4][3];
+    tet_displacements(tet, t, u, U);
+    physics::TetDeformation<S> d;
+    physics::tet_deformation<true, S>(U, data[t].Dinv, data[t].vol_lambda, data[t].vol_mu, d);
+    return d;
+}
+
 template <class S>
 class DeviceTetOperator final : public ElasticOperator<S> {
 public:
@@ -57,10 +68,7 @@ public:
         const S* u = u_.data();
         S* K = K_.data();
         launch_.each(std::size_t(nt_), [=] __device__(std::size_t t) {
-            S U[4][3];
-            tet_displacements(tet, t, u, U);
-            physics::TetDeformation<S> d;
-            physics::tet_deformation<true, S>(U, data[t].Dinv, data[t].vol_lambda, data[t].vol_mu, d);
+            const physics::TetDeformation<S> d = deformation(tet, data, t, u);
             physics::TetStiffnessTerms<S> k;
             physics::tet_stiffness_terms<S>(d, data[t].Dinv, data[t].vol_lambda, data[t].vol_mu, k);
             physics::tet_stiffness_blocks(k, &K[90 * t]);
@@ -115,10 +123,7 @@ public:
         S* out = per_tet_.data();
         double* w = w_.data();
         launch_.each(std::size_t(nt_), [=] __device__(std::size_t t) {
-            S U[4][3];
-            tet_displacements(tet, t, u, U);
-            physics::TetDeformation<S> d;
-            physics::tet_deformation<true, S>(U, data[t].Dinv, data[t].vol_lambda, data[t].vol_mu, d);
+            const physics::TetDeformation<S> d = deformation(tet, data, t, u);
             w[t] = double(d.energy);
             if (!forces) return;
             S ft[4][3];

@@ -1,9 +1,8 @@
 // The vector kernels (vector_kernels.hpp) on the device: the unified bodies
-// (unified/unified_vector_kernels.hpp) on DeviceLaunch's loops; the *_range
-// kernels as launches over their range, and CG as device_cg.
+// (unified/unified_vector_kernels.hpp, CG included) on DeviceLaunch's loops,
+// and the *_range kernels as launches over their range.
 #pragma once
 
-#include "cuda/device_cg.cuh"
 #include "cuda/device_launch.cuh"
 #include "unified/unified_vector_kernels.hpp"
 
@@ -19,10 +18,6 @@ public:
                                double* out) const override;
     void block_jacobi_apply_range(std::size_t lo, std::size_t hi, const double* Dinv, const double* r,
                                   double* z) const override;
-    CgResult cg(CgSystem& A, const CgPreconditioner& M, const std::uint8_t* free_dof, const double* b, double* x,
-                std::size_t n, const CgSettings& settings, CgWork& work) const override {
-        return device_cg(this->launch_, A, M, free_dof, b, x, n, settings, work);
-    }
 };
 
 extern template class DeviceVectorKernels<double>;

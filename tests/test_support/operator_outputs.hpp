@@ -1,0 +1,95 @@
+// What an elastic operator gives at one configuration (forces, energy, K x
+// with the plain and the definite K, diagonal blocks, inverted tets), read
+// back in double from any back-end's memory, and the comparison the
+// back-end tests make against the reference back-end.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "edgefem/core/backend_vector.hpp"
+#include "edgefem/core/elastic_operator.hpp"
+#include "edgefem/core/material.hpp"
+
+namespace edgefem::test {
+
+// E = 1e5, nu = 0.3, rho = 1000.
+inline const Materials& backend_test_material() {
+    static const Materials m(Material{1e5, 0.3, 1000});
+    return m;
+}
+
+// |a - b|_max / |b|_max (b the reference).
+inline double rel_max(const std::vector<double>& a, const std::vector<double>& b) {
+    double d = 0, s = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        d = std::max(d, std::abs(a[i] - b[i]));
+        s = std::max(s, std::abs(b[i]));
+    }
+    return s > 0 ? d / s : d;
+}
+
+// A smooth direction for K x.
+inline std::vector<double> direction(std::size_t n) {
+    std::vector<double> x(n);
+    for (std::size_t i = 0; i < n; ++i) x[i] = std::sin(0.37 * double(i) + 1.0);
+    return x;
+}
+
+struct Outputs {
+    double energy = 0;       // forces()'s
+    double energy_only = 0;  // energy()'s
+    std::vector<double> f, Kx, Kx_definite, D;
+    index_t inverted = 0;
+};
+
+// The operator's outputs at u, K x at x; `edge`: the definite K x too. The
+// vectors live in `memory` (copied to and from the host around the calls).
+template <class S>
+Outputs evaluate(ElasticOperator<S>& op, const std::vector<double>& u_d, const std::vector<double>& x_d, bool edge,
+                 const VectorMemory& memory = host_memory()) {
+    const std::vector<S> uh(u_d.begin(), u_d.end()), xh(x_d.begin(), x_d.end());
+    BackendVector<S> u(memory, uh.size()), x(memory, xh.size()), f(memory, uh.size()), y(memory, uh.size()),
+        D(memory, 3 * uh.size());
+    u.write(uh);
+    x.write(xh);
+    const auto get = [](const BackendVector<S>& v) {
+        std::vector<S> h(v.size());
+        v.read(h);
+        return std::vector<double>(h.begin(), h.end());
+    };
+    Outputs o;
+    o.energy = op.forces(u.data(), f.data(), true);
+    op.build_stiffness(false);
+    op.multiply(x.data(), y.data());
+    op.diagonal_blocks(D.data());
+    o.f = get(f);
+    o.Kx = get(y);
+    o.D = get(D);
+    if (edge) {
+        op.build_stiffness(true);
+        op.multiply(x.data(), y.data());
+        o.Kx_definite = get(y);
+    }
+    o.energy_only = op.energy(u.data());
+    o.inverted = op.inverted_tets(u.data());
+    return o;
+}
+
+// Each output within `tol` of the reference's, relative to its largest entry.
+inline void expect_close(const Outputs& got, const Outputs& ref, double tol, const std::string& what) {
+    EXPECT_LE(std::abs(got.energy - ref.energy), tol * std::abs(ref.energy)) << what << " energy";
+    EXPECT_LE(std::abs(got.energy_only - ref.energy), tol * std::abs(ref.energy)) << what << " energy()";
+    EXPECT_LE(rel_max(got.f, ref.f), tol) << what << " forces";
+    EXPECT_LE(rel_max(got.Kx, ref.Kx), tol) << what << " K x";
+    EXPECT_LE(rel_max(got.D, ref.D), tol) << what << " diagonal blocks";
+    if (!ref.Kx_definite.empty()) {
+        EXPECT_LE(rel_max(got.Kx_definite, ref.Kx_definite), tol) << what << " definite K x";
+    }
+    EXPECT_EQ(got.inverted, ref.inverted) << what << " inverted tets";
+}
+
+}  // namespace edgefem::test
