@@ -59,14 +59,8 @@ std::vector<Config> cpu_configs() {
     return c;
 }
 
-struct Case {
-    ModelKind model;
-    Method method;
-    const char* name;
-};
-constexpr Case kCases[] = {{ModelKind::FE, Method::Edge, "edge-fe"},
-                           {ModelKind::SN, Method::Edge, "edge-sn"},
-                           {ModelKind::FE, Method::Tet, "tet"}};
+using test::Case;
+using test::kCases;
 
 }  // namespace
 

@@ -47,14 +47,8 @@ bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
 }
 
-struct Case {
-    ModelKind model;
-    Method method;
-    const char* name;
-};
-constexpr Case kCases[] = {{ModelKind::FE, Method::Edge, "edge-fe"},
-                           {ModelKind::SN, Method::Edge, "edge-sn"},
-                           {ModelKind::FE, Method::Tet, "tet"}};
+using test::Case;
+using test::kCases;
 
 }  // namespace
 

@@ -39,6 +39,16 @@ inline std::vector<double> direction(std::size_t n) {
     return x;
 }
 
+// The models every back-end implements.
+struct Case {
+    ModelKind model;
+    Method method;
+    const char* name;
+};
+inline constexpr Case kCases[] = {{ModelKind::FE, Method::Edge, "edge-fe"},
+                                  {ModelKind::SN, Method::Edge, "edge-sn"},
+                                  {ModelKind::FE, Method::Tet, "tet"}};
+
 struct Outputs {
     double energy = 0;       // forces()'s
     double energy_only = 0;  // energy()'s
