@@ -1,11 +1,14 @@
-// `edgefem info MESH`: sizes, model memory and shape statistics of a mesh.
+// `edgefem info MESH`: sizes, regions, the boundary, model memory and shape
+// statistics of a mesh.
 #include <chrono>
+#include <map>
 #include <memory>
 
 #include "common.hpp"
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/mesh_quality.hpp"
+#include "edgefem/core/surface.hpp"
 #include "edgefem/core/tet_model.hpp"
 #include "edgefem/core/topology.hpp"
 
@@ -36,6 +39,11 @@ void run_info(const MeshOptions& opts) {
     print_kv("tseps", topo.num_tseps());
     print_kv("tseps_vertex_sharing", topo.num_tseps() - topo.num_opposite_tseps());
     print_kv("tseps_opposite", topo.num_opposite_tseps());
+    print_kv("boundary_triangles", boundary_surface(mesh).triangles.size());
+    std::map<int, long> region_tets;
+    for (index_t t = 0; t < mesh.num_tets(); ++t) ++region_tets[mesh.tet_region(t)];
+    print_kv("regions", region_tets.size());
+    for (const auto& [r, n] : region_tets) print_kv("region " + std::to_string(r), std::to_string(n) + " tets");
     print_kv("bytes_per_tet", fmt(edge.bytes_per_tet(true), 6));
     print_kv("bytes_per_tet_force_only", fmt(edge.bytes_per_tet(false), 6));
     print_kv("bytes_per_tet_per_tet_method", fmt(tet.bytes_per_tet(), 6));
