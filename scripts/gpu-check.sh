@@ -19,24 +19,32 @@ cd "$(dirname "$0")/.."
 PROGRAMS="edgefem edgefem_test_cuda_backend edgefem_bench_gpu"
 mesh_dir=${EDGEFEM_MESH_DIR:-../shared/meshes}
 
-# The check itself: $1 runs a program of the build ($1 NAME ARGS...).
+# run_prog SECONDS NAME ARGS...: a program of the build or the bundle
+# ($BIN, started through $LAUNCH), with a time limit.
+run_prog() {
+    local s=$1 p=$2
+    shift 2
+    # shellcheck disable=SC2086
+    timeout "$s" $LAUNCH "$BIN/$p" "$@"
+}
+
+# The check itself.
 check() {
-    local X=$1
     echo "== gpu-check $(date -u +%FT%TZ)"
     nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv 2>&1 | head -3
     nvcc --version 2>/dev/null | tail -1
     echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2) x $(nproc)"
     echo "== GPU tests"
-    timeout 300 $X edgefem_test_cuda_backend --gtest_brief=0 2>&1 | tail -40
+    run_prog 300 edgefem_test_cuda_backend 2>&1 | tail -40
     echo "tests rc=${PIPESTATUS[0]}"
     echo "== GPU benchmarks"
-    timeout 150 $X edgefem_bench_gpu --meshes armadillo-7k,bunny-250k,bunny-1m 2>&1
+    run_prog 150 edgefem_bench_gpu --meshes armadillo-7k,bunny-250k,bunny-1m 2>&1
     echo "bench rc=$?"
     echo "== CPU sweep: semi-implicit step, 20 CG iterations, bunny-250k"
     for t in 1 2 4 8 16; do
         echo "-- threads $t"
-        timeout 40 $X edgefem bench bunny-250k --kernel step --cg-iters 20 --backend pool --threads "$t" --seconds 3 2>&1 \
-            | grep -E "median_ms|min_ms|backend" || true
+        run_prog 40 edgefem bench "$EDGEFEM_MESH_DIR/bunny-250k" --kernel step --cg-iters 20 --backend pool --threads "$t" --seconds 3 2>&1 \
+            | grep -E "median_ms|min_ms|backend|error" || true
     done
     echo "== gpu-check done $(date -u +%FT%TZ)"
 }
@@ -47,8 +55,8 @@ build)
     cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DEDGEFEM_CUDA=ON -DEDGEFEM_NATIVE=OFF >/dev/null || exit 1
     cmake --build build-gpu -j "$(nproc)" --target $PROGRAMS >/dev/null || exit 1
     export EDGEFEM_MESH_DIR=$mesh_dir
-    run_built() { local p=$1; shift; "build-gpu/bin/$p" "$@"; }
-    check run_built 2>&1 | tee "$log"
+    BIN=build-gpu/bin LAUNCH=""
+    check 2>&1 | tee "$log"
     ;;
 pack)
     B=.gpubundle
@@ -74,16 +82,15 @@ B=$(cd "$(dirname "$0")" && pwd)
 export EDGEFEM_MESH_DIR=$B/meshes
 # The driver's libcuda from the machine, everything else from the bundle.
 cuda_dir=$(dirname "$(ldconfig -p | awk '/libcuda.so.1/ {print $NF; exit}')" 2>/dev/null)
-exec bash "$B/gpu-check.sh" bundle "$B" "${cuda_dir:-/usr/lib/x86_64-linux-gnu}"
+exec bash "$B/gpu-check.sh" bundle "$B" "${cuda_dir:-.}:/usr/local/nvidia/lib64:/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 RUN
     chmod +x "$B/run.sh"
     du -sh "$B"
     ;;
 bundle)
-    B=$2
-    export B CUDA_LIB=$3
-    run_bundled() { local p=$1; shift; "$B/lib/ld-linux-x86-64.so.2" --library-path "$B/lib:$CUDA_LIB" "$B/bin/$p" "$@"; }
-    check run_bundled 2>&1 | tee "$log"
+    export EDGEFEM_MESH_DIR=$2/meshes
+    BIN=$2/bin LAUNCH="$2/lib/ld-linux-x86-64.so.2 --library-path $2/lib:$3"
+    check 2>&1 | tee "$log"
     ;;
 *)
     echo "usage: scripts/gpu-check.sh [build | pack]" >&2
