@@ -37,6 +37,13 @@ void expect_small_mesh(const Mesh& m, bool with_region) {
     EXPECT_EQ(m.source.tet_id.size(), 3u);
 }
 
+// small.veg: the same mesh; its one *MATERIAL covers every tet (region 1).
+void expect_small_vega(Mesh m) {
+    EXPECT_EQ(m.region, (std::vector<int>{1, 1, 1}));
+    m.region.clear();
+    expect_small_mesh(m, false);
+}
+
 std::string replace_once(std::string text, const std::string& from, const std::string& to) {
     const auto at = text.find(from);
     EXPECT_NE(at, std::string::npos) << "test setup: '" << from << "' not found";
@@ -53,15 +60,15 @@ TEST(read_mesh, AllFormatsGiveTheSameMesh) {
     expect_small_mesh(read_gmsh(data_file("small22.msh")), true);
     expect_small_mesh(read_gmsh(data_file("small41.msh")), true);
     expect_small_mesh(read_medit(data_file("small.mesh")), true);
-    expect_small_mesh(read_vega(data_file("small.veg")), false);
+    expect_small_vega(read_vega(data_file("small.veg")));
     // Dispatch by extension and by TetGen prefix.
     expect_small_mesh(read_mesh(data_file("small0")), false);
     expect_small_mesh(read_mesh(data_file("small1.node")), true);
     expect_small_mesh(read_mesh(data_file("small22.msh")), true);
     expect_small_mesh(read_mesh(data_file("small41.msh")), true);
     expect_small_mesh(read_mesh(data_file("small.mesh")), true);
-    expect_small_mesh(read_mesh(data_file("small.veg")), false);
-    expect_small_mesh(read_mesh(data_file("small.veg"), MeshFormat::Vega), false);
+    expect_small_vega(read_mesh(data_file("small.veg")));
+    expect_small_vega(read_mesh(data_file("small.veg"), MeshFormat::Vega));
 }
 
 TEST(read_mesh, TetGenSourceLinesAndIds) {
@@ -496,4 +503,122 @@ TEST(read_mesh_fuzz, TruncationsAndByteFlips) {
     }
     EXPECT_GT(reads, 0);
     EXPECT_GT(errors, 0);
+}
+
+// Vega *MATERIAL / *SET / *REGION: each material becomes a region (the
+// i-th *MATERIAL is region i) and ReadReport::materials carries its
+// constants, so a two-material .veg is not simulated with one default.
+TEST(read_mesh, VegaMaterialsBecomeRegions) {
+    edgefem::test::TempDir dir("vegamat");
+    ReadReport report;
+    const Mesh one = read_vega(data_file("small.veg"), &report);
+    EXPECT_EQ(one.region, (std::vector<int>{1, 1, 1}));
+    ASSERT_EQ(report.materials.size(), 1u);
+    EXPECT_EQ(report.materials.at(1).young, 1e7);
+    EXPECT_EQ(report.materials.at(1).poisson, 0.45);
+    EXPECT_EQ(report.materials.at(1).density, 1000);
+    EXPECT_EQ(report.material_names.at(1), "defaultMaterial");
+
+    const std::string veg = edgefem::test::slurp(data_file("small.veg"));
+    const std::string two_text = replace_once(veg, "*SET allElements\n1, 2, 3,\n\n*REGION\nallElements, defaultMaterial",
+                                              "*MATERIAL steel\nENU, 7800, 2e11, 0.3\n*SET soft\n1,\n3\n*SET hard\n2\n"
+                                              "*REGION\nsoft, defaultMaterial\nhard, steel");
+    edgefem::test::spit(dir.file("two.veg"), two_text);
+    ReadReport r2;
+    const Mesh two = read_vega(dir.file("two.veg"), &r2);
+    EXPECT_EQ(two.region, (std::vector<int>{1, 2, 1}));
+    ASSERT_EQ(r2.materials.size(), 2u);
+    EXPECT_EQ(r2.materials.at(1).young, 1e7);
+    EXPECT_EQ(r2.materials.at(2).young, 2e11);
+    EXPECT_EQ(r2.materials.at(2).density, 7800);
+
+    // Errors name the file, the line and the thing.
+    const auto write = [&](const std::string& name, const std::string& text) {
+        edgefem::test::spit(dir.file(name), text);
+        return dir.file(name);
+    };
+    auto p = write("badtype.veg", replace_once(veg, "ENU, 1000, 10000000, 0.45", "MOONEYRIVLIN, 1000, 1, 2, 3"));
+    expect_mesh_error([&] { read_vega(p); }, {"badtype.veg:20:", "MOONEYRIVLIN", "only ENU"});
+    p = write("badnu.veg", replace_once(veg, "ENU, 1000, 10000000, 0.45", "ENU, 1000, 10000000, 0.7"));
+    expect_mesh_error([&] { read_vega(p); }, {"badnu.veg:20:", "defaultMaterial", "oisson"});
+    p = write("noset.veg", replace_once(veg, "allElements, defaultMaterial", "nothere, defaultMaterial"));
+    expect_mesh_error([&] { read_vega(p); }, {"noset.veg:26:", "set 'nothere'"});
+    p = write("nomat.veg", replace_once(veg, "allElements, defaultMaterial", "allElements, wood"));
+    expect_mesh_error([&] { read_vega(p); }, {"nomat.veg:26:", "material 'wood'"});
+    p = write("setrange.veg", replace_once(veg, "1, 2, 3,", "1, 2, 9"));
+    expect_mesh_error([&] { read_vega(p); }, {"setrange.veg:23:", "element 9", "1..3"});
+    p = write("twice.veg", replace_once(two_text, "2\n*REGION", "2, 3\n*REGION"));
+    expect_mesh_error([&] { read_vega(p); }, {"twice.veg:", "tet 2 (numbered 3 in the file)", "two regions"});
+    // A region that leaves tets without a material is said, not silent.
+    ReadReport r3;
+    p = write("partial.veg", replace_once(two_text, "hard, steel", ""));
+    const Mesh partial = read_vega(p, &r3);
+    EXPECT_EQ(partial.region, (std::vector<int>{1, 0, 1}));
+    ASSERT_FALSE(r3.warnings.empty());
+    EXPECT_NE(r3.warnings[0].find("1 of 3 tets"), std::string::npos) << r3.warnings[0];
+    // Sections edgefem does not read are a warning naming them.
+    ReadReport r4;
+    p = write("other.veg", veg + "\n*FIXEDVERTICES\n1, 2\n");
+    read_vega(p, &r4);
+    ASSERT_EQ(r4.warnings.size(), 1u);
+    EXPECT_NE(r4.warnings[0].find("*FIXEDVERTICES"), std::string::npos) << r4.warnings[0];
+}
+
+// Cubic (20-node) and higher Gmsh tets keep their corners, as quadratic ones
+// do; they used to be refused as "not tets".
+TEST(read_mesh, GmshCubicTetsKeepCorners) {
+    edgefem::test::TempDir dir("readp3");
+    const std::string msh = edgefem::test::slurp(data_file("small22.msh"));
+    const std::string extra16 = " 7 7 7 7 7 7 7 7 7 7 7 7 7 7 7 7";
+    std::string m20 = replace_once(msh, "4 4 2 1 100 10 20 30 40", "4 29 2 1 100 10 20 30 40" + extra16);
+    m20 = replace_once(m20, "6 4 2 2 100 20 30 40 55", "6 29 2 2 100 20 30 40 55" + extra16);
+    edgefem::test::spit(dir.file("t20.msh"), m20);
+    ReadReport report;
+    const Mesh g = read_gmsh(dir.file("t20.msh"), &report);
+    EXPECT_EQ(g.tets, kTets);
+    EXPECT_EQ(g.region, kRegion);
+    EXPECT_TRUE(report.high_order_tets);
+    ASSERT_EQ(report.warnings.size(), 1u);
+    EXPECT_NE(report.warnings[0].find("2 x 20-node"), std::string::npos) << report.warnings[0];
+    // A missing node of a cubic tet is still an error naming the line.
+    edgefem::test::spit(dir.file("short20.msh"), replace_once(m20, "55" + extra16, "55 7 7"));
+    expect_mesh_error([&] { read_gmsh(dir.file("short20.msh")); }, {"short20.msh:", "tet node tag"});
+}
+
+// A region is an integer: -2.7 used to become region -3 silently.
+TEST(read_mesh_errors, TetGenNonIntegerAttribute) {
+    edgefem::test::TempDir dir("readattr");
+    const std::string node = edgefem::test::slurp(data_file("small1.node"));
+    const std::string ele = edgefem::test::slurp(data_file("small1.ele"));
+    edgefem::test::spit(dir.file("attr.node"), node);
+    edgefem::test::spit(dir.file("attr.ele"), replace_once(ele, "1  1 2 3 4   1.0  9.75", "1  1 2 3 4   -2.7  9.75"));
+    expect_mesh_error([&] { read_tetgen(dir.file("attr")); }, {"attr.ele:3:", "region attribute -2.7", "not an integer"});
+    // 2.0 is the integer 2; the second attribute is not a region and may be anything.
+    edgefem::test::spit(dir.file("attr.ele"), replace_once(ele, "1  1 2 3 4   1.0  9.75", "1  1 2 3 4   2.0  9.75"));
+    EXPECT_EQ(read_tetgen(dir.file("attr")).region[0], 2);
+}
+
+// A header that declares far more items than the file holds fails at the
+// first short line, before memory is sized from the count: the readers grow
+// with what the file holds (they used to resize to the declared count,
+// 20x the file's size in resident memory).
+TEST(read_mesh_errors, HugeCountBackedByShortLinesStaysSmall) {
+    edgefem::test::TempDir dir("readhuge");
+    const int n = 2000000;
+    std::string lines;
+    lines.reserve(2 * static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) lines += "1\n";
+    edgefem::test::spit(dir.file("h.node"), std::to_string(n) + " 3 0 0\n" + lines);
+    edgefem::test::spit(dir.file("h.ele"), "1 4 0\n1 1 2 3 4\n");
+    edgefem::test::spit(dir.file("h.veg"), "*VERTICES\n" + std::to_string(n) + " 3 0 0\n" + lines);
+    edgefem::test::spit(dir.file("h.mesh"), "MeshVersionFormatted 2\nDimension 3\nVertices\n" + std::to_string(n) + "\n" + lines);
+    lines.clear();
+    lines.shrink_to_fit();
+    const long before = edgefem::test::peak_rss_kb();
+    expect_mesh_error([&] { read_tetgen(dir.file("h.node")); }, {"h.node:2:", "missing x coordinate"});
+    expect_mesh_error([&] { read_vega(dir.file("h.veg")); }, {"h.veg:3:", "missing x coordinate"});
+    expect_mesh_error([&] { read_medit(dir.file("h.mesh")); }, {"h.mesh:5:", "missing y coordinate"});
+    const long grown = edgefem::test::peak_rss_kb() - before;
+    // The file itself (4 MB) is loaded; 2 million vertices would be 80 MB.
+    EXPECT_LT(grown, 30 * 1024) << "peak RSS grew by " << grown << " kB";
 }

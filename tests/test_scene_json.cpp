@@ -470,3 +470,98 @@ TEST(SceneJson, SemiImplicitOnlyKeys) {
 
 }  // namespace
 }  // namespace edgefem::test
+
+namespace edgefem::test {
+namespace {
+
+// A two-material Vega file: its materials hold for their regions (they used
+// to be dropped: every tet ran with the default 1e5 Pa), and "regions"
+// overrides them field by field.
+TEST(SceneJson, VegaMaterialsApply) {
+    TempDir dir("scene_vega");
+    std::string veg = slurp(data_file("small.veg"));
+    const std::string from = "*SET allElements\n1, 2, 3,\n\n*REGION\nallElements, defaultMaterial";
+    ASSERT_NE(veg.find(from), std::string::npos);
+    veg.replace(veg.find(from), from.size(),
+                "*MATERIAL steel\nENU, 7800, 2e11, 0.3\n*SET soft\n1, 3\n*SET hard\n2\n*REGION\nsoft, defaultMaterial\nhard, steel");
+    spit(dir.file("two.veg"), veg);
+    const SceneFile sf = parse(R"({"mesh": "two.veg", "material": {"young": 5}})", dir.path());
+    const Materials& m = sf.scene.materials;
+    EXPECT_EQ(sf.scene.mesh.region, (std::vector<int>{1, 2, 1}));
+    EXPECT_EQ(m.of(1).young, 1e7);
+    EXPECT_EQ(m.of(1).poisson, 0.45);
+    EXPECT_EQ(m.of(2).young, 2e11);
+    EXPECT_EQ(m.of(2).density, 7800);
+    EXPECT_EQ(m.fallback.young, 5);
+    EXPECT_TRUE(std::any_of(sf.warnings.begin(), sf.warnings.end(), [](const std::string& w) {
+        return w.find("1 (defaultMaterial), 2 (steel)") != std::string::npos;
+    }));
+    const SceneFile over = parse(R"({"mesh": "two.veg", "regions": {"2": {"young": 3e11}}})", dir.path());
+    EXPECT_EQ(over.scene.materials.of(2).young, 3e11);
+    EXPECT_EQ(over.scene.materials.of(2).density, 7800);  // the rest from the file
+    EXPECT_EQ(over.scene.materials.of(1).young, 1e7);
+}
+
+TEST(SceneJsonErrors, DuplicateKeysNameTheKey) {
+    EXPECT_EQ(expect_error(R"({"mesh": "box:2x2x2", "steps": 3, "steps": 5})", {}),
+              "scene.json: \"steps\": duplicate key (each key may appear once)");
+    expect_error(scene(R"("solver": {"cg_tolerance": 1e-6, "cg_tolerance": 1e-3})"), {"\"solver.cg_tolerance\"", "duplicate key"});
+    expect_error(scene(R"("fixed": [{"vertices": [0]}, {"box": {"min": [0, 0, 0], "min": [1, 1, 1]}}])"),
+                 {"\"fixed[1].box.min\"", "duplicate key"});
+    // The same key in two objects is no duplicate.
+    EXPECT_NO_THROW(parse(scene(R"("fixed": [{"vertices": [0]}, {"vertices": [1]}])")));
+}
+
+TEST(SceneJson, FailOnInvertedKey) {
+    EXPECT_FALSE(parse(scene("")).scene.solver.fail_on_inverted);
+    EXPECT_TRUE(parse(scene(R"("solver": {"fail_on_inverted": true})")).scene.solver.fail_on_inverted);
+    expect_error(scene(R"("solver": {"fail_on_inverted": 1})"), {"\"solver.fail_on_inverted\"", "true or false"});
+}
+
+// Compaction keeps a map back to the file's numbering (docs/scenes.md); the
+// unreferenced-vertex error names the scene's option, not a CLI flag.
+TEST(SceneJson, CompactionKeepsTheFileNumbering) {
+    const std::string mesh = R"("mesh": ")" + data_file("bad/unreferenced.node") + R"(")";
+    const SceneFile sf = parse("{" + mesh + R"(, "mesh_options": {"compact": true}})");
+    EXPECT_EQ(sf.file_vertex, (std::vector<index_t>{0, 1, 2, 3, 4, 6}));
+    EXPECT_TRUE(parse(scene("")).file_vertex.empty());
+    const std::string msg = expect_error("{" + mesh + "}", {"\"mesh\"", "used by no tet", "mesh_options.compact"});
+    EXPECT_EQ(msg.find("--compact"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("ValidationOptions"), std::string::npos) << msg;
+    const std::string inv = expect_error<MeshError>(R"({"mesh": ")" + data_file("bad/inverted") + R"("})",
+                                                   {"mesh_options.fix_orientation"});
+    EXPECT_EQ(inv.find("--fix-orientation"), std::string::npos) << inv;
+}
+
+// Second-order tets load without "compact": their mid-edge nodes are
+// dropped, and file_vertex maps the output back to the file's numbering.
+TEST(SceneJson, SecondOrderTetsLoadWithoutCompact) {
+    TempDir dir("scene_p2");
+    // Nodes 1-6 are mid-edge nodes, 7-10 the corners.
+    spit(dir.file("t10.msh"),
+         "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n10\n"
+         "1 0.05 0 0\n2 0.05 0.05 0\n3 0 0.05 0\n4 0 0 0.05\n5 0.05 0 0.05\n6 0 0.05 0.05\n"
+         "7 0 0 0\n8 0.1 0 0\n9 0 0.1 0\n10 0 0 0.1\n$EndNodes\n"
+         "$Elements\n1\n1 11 2 1 1 7 8 9 10 1 2 3 4 5 6\n$EndElements\n");
+    const SceneFile sf = parse(R"({"mesh": "t10.msh", "fixed": {"vertices": [6]}})", dir.path());
+    EXPECT_EQ(sf.scene.mesh.num_vertices(), 4);
+    EXPECT_EQ(sf.scene.mesh.tets, (std::vector<index_t>{0, 1, 2, 3}));
+    EXPECT_EQ(sf.file_vertex, (std::vector<index_t>{6, 7, 8, 9}));
+    EXPECT_EQ(sf.scene.fixed, (std::vector<index_t>{0}));  // file vertex 6 is scene vertex 0
+}
+
+// Echoed input is cut and escaped: a 1 MB path gave a 1 MB message, and
+// terminal escape codes reached the terminal raw.
+TEST(SceneJsonErrors, EchoedInputIsCutAndEscaped) {
+    const std::string huge(1000000, 'a');
+    const std::string msg = expect_error<MeshError>(R"({"mesh": "/nonexistent/)" + huge + R"(.node"})", {"scene.json", "..."});
+    EXPECT_LT(msg.size(), 1000u) << msg.substr(0, 300);
+    const std::string esc = expect_error<MeshError>("{\"mesh\": \"/nonexistent/\\u001b[31mred.node\"}", {"\\x1b[31mred"});
+    EXPECT_EQ(esc.find('\x1b'), std::string::npos);
+    const std::string key = expect_error(scene("\"" + std::string(5000, 'k') + "\\u001b\": 1"), {"unknown key"});
+    EXPECT_EQ(key.find('\x1b'), std::string::npos);
+    EXPECT_LT(key.size(), 1000u);
+}
+
+}  // namespace
+}  // namespace edgefem::test

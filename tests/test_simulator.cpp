@@ -779,3 +779,32 @@ TEST(Simulator, GuardMessageFromRestGivesTheGain) {
     EXPECT_NE(msg.find("no kinetic or elastic energy"), std::string::npos) << msg;
     EXPECT_EQ(msg.find("e+2"), std::string::npos) << msg;  // no 1e200-size ratio
 }
+
+// Every vertex driven to its mirror image (x -> -x): every tet ends the
+// step inverted. The step is counted (StepStats::inverted_tets) and, with
+// solver.fail_on_inverted, fails with a SimulationError naming the count.
+TEST(Simulator, FailOnInvertedTets) {
+    for (const Integrator integrator : {Integrator::Explicit, Integrator::Implicit}) {
+        Scene s;
+        s.mesh = make_box(2, 1, 1);
+        s.integrator = integrator;
+        s.dt = 1e-3;
+        for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+            s.prescribed.push_back({v, {-s.mesh.X[3 * v], s.mesh.X[3 * v + 1], s.mesh.X[3 * v + 2]}});
+        {
+            Simulator<double> sim(s);
+            EXPECT_EQ(sim.step().inverted_tets, s.mesh.num_tets()) << to_string(integrator);
+        }
+        s.solver.fail_on_inverted = true;
+        Simulator<double> sim(s);
+        try {
+            sim.step();
+            ADD_FAILURE() << "no error with fail_on_inverted (" << to_string(integrator) << ")";
+        } catch (const SimulationError& e) {
+            EXPECT_EQ(e.step(), 1);
+            EXPECT_NE(std::string(e.what()).find("12 inverted tets"), std::string::npos) << e.what();
+        }
+        s.count_inverted_tets = false;
+        EXPECT_THROW(s.validate(), InvalidArgument);
+    }
+}

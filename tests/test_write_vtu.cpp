@@ -1,6 +1,12 @@
 // VTU / PVD output: write small meshes, parse the numbers back.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <csignal>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -141,3 +147,86 @@ TEST(write_vtu, UnwritablePathThrows) {
     edgefem::test::TempDir dir("vtudir");
     EXPECT_THROW(write_vtu(dir.path(), box), edgefem::Error);  // a directory
 }  // ~PvdSeries swallows the same error
+
+namespace {
+
+// Runs `body` in a child process whose files may not grow past `limit`
+// bytes (RLIMIT_FSIZE, with SIGXFSZ ignored: a write past it fails with
+// EFBIG, as on a full disk); returns the child's exit status (0 = body
+// returned true).
+template <class F>
+int with_file_size_limit(rlim_t limit, F&& body) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        std::signal(SIGXFSZ, SIG_IGN);
+        rlimit r{limit, limit};
+        ::setrlimit(RLIMIT_FSIZE, &r);
+        bool ok = false;
+        try {
+            ok = body();
+        } catch (...) {
+        }
+        ::_exit(ok ? 0 : 1);
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 100 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+std::vector<std::string> files_in(const std::string& dir) {
+    std::vector<std::string> out;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) out.push_back(e.path().filename().string());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+}  // namespace
+
+// A write that fails part way (a full disk) leaves no partial .vtu, keeps
+// the previous .pvd whole, and throws IoError naming the file. The .pvd used
+// to be truncated and rewritten in place: a full disk left 4096 bytes of
+// broken XML and every frame unreachable.
+TEST(write_vtu, FailedWritesLeaveNoPartialFiles) {
+    edgefem::test::TempDir dir("vtufull");
+    const Mesh box = make_box(10, 10, 10);  // a frame of about 200 kB
+    const std::string pvd = dir.file("s.pvd");
+    {
+        PvdSeries series(pvd);
+        series.add(0, dir.file("f0.vtu"));
+        series.write();
+    }
+    const std::string good_pvd = slurp(pvd);
+    ASSERT_TRUE(contains(good_pvd, "</VTKFile>"));
+    const int status = with_file_size_limit(64 * 1024, [&] {
+        bool vtu_failed = false, pvd_failed = false;
+        try {
+            write_vtu(dir.file("big.vtu"), box);
+        } catch (const IoError& e) {
+            vtu_failed = contains(e.what(), dir.file("big.vtu")) && e.path() == dir.file("big.vtu") &&
+                         contains(e.what(), "too large");
+        }
+        PvdSeries series(pvd);
+        for (int k = 0; k < 2000; ++k) series.add(k, dir.file("frame_with_a_long_name_" + std::to_string(k) + ".vtu"));
+        try {
+            series.write();
+        } catch (const IoError& e) {
+            pvd_failed = contains(e.what(), pvd);
+        }
+        return vtu_failed && pvd_failed;  // the destructor's retry fails silently
+    });
+    EXPECT_EQ(status, 0) << "the child saw no IoError naming the file (or crashed)";
+    EXPECT_EQ(slurp(pvd), good_pvd);  // the old series, whole
+    EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"s.pvd"}));  // no partial or temporary file
+}
+
+// A symbolic link at the output name is replaced, never followed: its
+// target keeps its contents.
+TEST(write_vtu, SymlinkAtTheNameIsNotFollowed) {
+    edgefem::test::TempDir dir("vtulink");
+    edgefem::test::spit(dir.file("precious.txt"), "keep me\n");
+    std::filesystem::create_symlink(dir.file("precious.txt"), dir.file("f.vtu"));
+    write_vtu(dir.file("f.vtu"), make_box(1, 1, 1));
+    EXPECT_EQ(slurp(dir.file("precious.txt")), "keep me\n");
+    EXPECT_FALSE(std::filesystem::is_symlink(dir.file("f.vtu")));
+    EXPECT_TRUE(contains(slurp(dir.file("f.vtu")), "</VTKFile>"));
+}

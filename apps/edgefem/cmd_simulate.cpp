@@ -14,6 +14,7 @@
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/write_vtu.hpp"
 #include "edgefem/partition/ordered_simulator.hpp"
+#include "output_paths.hpp"
 #include "sim_common.hpp"
 
 namespace edgefem::cli {
@@ -77,7 +78,11 @@ void run_simulate(const SimulateOptions& opts) {
     using clock = std::chrono::steady_clock;
     const auto t_start = clock::now();
     SceneFile sf = load_scene_file(opts.scene);
-    if (!opts.out.empty()) sf.output.dir = opts.out;
+    // A scene stays under the current folder; --out may name any folder.
+    if (opts.out.empty())
+        check_scene_output_dir(sf.output.dir, sf.path.empty() ? "the built-in scene" : sf.path);
+    else
+        sf.output.dir = opts.out;
     if (opts.steps >= 0) sf.scene.steps = opts.steps;
     const OutputSettings out = sf.output;
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
@@ -92,9 +97,17 @@ void run_simulate(const SimulateOptions& opts) {
     std::optional<FrameWriter> frames;
     std::optional<PvdSeries> series;
     if (out.vtu) {
-        std::filesystem::create_directories(out.dir);
-        frames.emplace(scene);
-        series.emplace((std::filesystem::path(out.dir) / (name + ".pvd")).string());
+        make_output_dir(out.dir, opts.out.empty() ? "output.dir" : "--out");
+        frames.emplace(scene, sf.file_vertex);
+        const std::string pvd = (std::filesystem::path(out.dir) / (name + ".pvd")).string();
+        check_replaceable(pvd, kPvdSignature);
+        series.emplace(pvd);
+        // Compaction renumbered the vertices: the map back to the file's numbering.
+        if (!sf.file_vertex.empty()) {
+            const std::string map = (std::filesystem::path(out.dir) / (name + ".vertex-map")).string();
+            check_replaceable(map, kVertexMapSignature);
+            write_vertex_map(map, sf.file_vertex);
+        }
     }
     char frame_name[64];
     std::vector<double> u_user(3 * std::size_t(scene.mesh.num_vertices())), f_user(u_user.size());
@@ -104,6 +117,7 @@ void run_simulate(const SimulateOptions& opts) {
         const std::string path = (std::filesystem::path(out.dir) / (name + frame_name)).string();
         osim.get_displacement(u_user);
         osim.get_forces(f_user);
+        check_replaceable(path, kVtuSignature);
         frames->write(path, u_user, f_user);
         series->add(sim.time(), path);
         series->write();  // a crash later still leaves a usable series
@@ -124,6 +138,7 @@ void run_simulate(const SimulateOptions& opts) {
     long cg_total = 0;
     int cg_max = 0;
     index_t inverted_max = 0;
+    long inverted_steps = 0, first_inverted_step = 0;
     long unconverged_steps = 0;  // CG stopped above its tolerance
     Progress progress(steps);
     write_frame();
@@ -138,6 +153,7 @@ void run_simulate(const SimulateOptions& opts) {
             cg_total += st.solver_iterations;
             cg_max = std::max(cg_max, st.solver_iterations);
             inverted_max = std::max(inverted_max, st.inverted_tets);
+            if (st.inverted_tets > 0 && inverted_steps++ == 0) first_inverted_step = s;
             unconverged_steps += st.unconverged_solves > 0;
             if (s % out.every == 0 || s == steps) {
                 write_frame();
@@ -150,6 +166,14 @@ void run_simulate(const SimulateOptions& opts) {
         throw;
     }
 
+    // Said once, not per step: a run full of inverted tets looks like a
+    // success otherwise (exit 0, one number in the summary).
+    if (inverted_steps > 0)
+        std::fprintf(stderr,
+                     "edgefem: warning: %ld of %ld steps ended with inverted tets (negative volume; at most %ld of "
+                     "%ld tets, first at step %ld): the results past that step are suspect "
+                     "(solver.fail_on_inverted makes this an error)\n",
+                     inverted_steps, steps, long(inverted_max), long(scene.mesh.num_tets()), first_inverted_step);
     const double e_drift = e_scale > 0 ? (e_last - e0.total()) / e_scale : 0.0;
     print_kv("scene", sf.path.empty() ? std::string("default (built-in beam)") : sf.path);
     print_kv("vertices", scene.mesh.num_vertices());

@@ -1,12 +1,15 @@
 // `edgefem static SCENE.json --out PREFIX`: static equilibrium of a scene
 // under its gravity and prescribed targets.
 #include <chrono>
+#include <cstdio>
 #include <memory>
+#include <string>
 
 #include "common.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/write_vtu.hpp"
 #include "edgefem/partition/ordered_simulator.hpp"
+#include "output_paths.hpp"
 #include "sim_common.hpp"
 
 namespace edgefem::cli {
@@ -24,7 +27,10 @@ void run_static(const StaticOptions& opts) {
     // typo in the folder should not cost the solve.
     check_writable("--out", opts.out + ".disp");
     check_writable("--out", opts.out + ".vtu");
+    check_replaceable(opts.out + ".disp", "");
+    check_replaceable(opts.out + ".vtu", kVtuSignature);
     SceneFile sf = load_scene_file(opts.scene);
+    if (!sf.file_vertex.empty()) check_replaceable(opts.out + ".vertex-map", kVertexMapSignature);
     const auto executor = make_run_executor(opts.run);
     OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering),
                                   make_run_backend<double>(opts.run, executor));
@@ -35,7 +41,10 @@ void run_static(const StaticOptions& opts) {
     osim.get_displacement(u);
     osim.get_forces(f);
     write_vectors(opts.out + ".disp", u);
-    FrameWriter(sf.scene).write(opts.out + ".vtu", u, f);
+    FrameWriter(sf.scene, sf.file_vertex).write(opts.out + ".vtu", u, f);
+    // Compaction renumbered the vertices: the .disp lines and .vtu points
+    // follow the scene's numbering; the map leads back to the file's.
+    if (!sf.file_vertex.empty()) write_vertex_map(opts.out + ".vertex-map", sf.file_vertex);
 
     print_kv("vertices", sim.num_vertices());
     print_kv("tets", sim.scene().mesh.num_tets());
@@ -51,6 +60,15 @@ void run_static(const StaticOptions& opts) {
     // The files are written either way: the last state helps to see why.
     if (!r.converged)
         throw SimulationError("static solve did not converge (residual " + fmt(r.residual, 3) + ")", sim.step_index());
+    if (const index_t inverted = sim.last_stats().inverted_tets; inverted > 0) {
+        if (sf.scene.solver.fail_on_inverted)
+            throw SimulationError("the equilibrium has " + std::to_string(inverted) +
+                                      " inverted tets (negative volume) and solver.fail_on_inverted is set",
+                                  sim.step_index());
+        std::fprintf(stderr, "edgefem: warning: the equilibrium has %ld of %ld tets inverted (negative volume): "
+                     "the result is suspect (solver.fail_on_inverted makes this an error)\n",
+                     long(inverted), long(sf.scene.mesh.num_tets()));
+    }
 }
 
 }  // namespace

@@ -13,6 +13,8 @@
 #include "cpu/edge_kernels.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
+#include "edgefem/core/memory_estimate.hpp"
+#include "edgefem/core/output_file.hpp"
 #include "edgefem/partition/ordering.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 #include "cpu/tet_kernels.hpp"
@@ -51,9 +53,17 @@ LoadedMesh load_mesh(const MeshOptions& opts) {
         m.mesh = make_box_from_spec(opts.path);
     else
         m.mesh = read_mesh(opts.path, MeshFormat::Auto, &m.read);
+    check_memory(opts.path, m.mesh.num_tets());
+    if (!m.read.materials.empty())
+        m.read.warnings.push_back(opts.path + ": the file's materials (" + std::to_string(m.read.materials.size()) +
+                                  ") apply to scene files only (regions 1.." +
+                                  std::to_string(m.read.materials.size()) + "); this command uses one material for every tet");
     ValidationOptions v;
     v.fix_orientation = opts.fix_orientation;
-    v.compact_unreferenced = opts.compact;
+    // Higher-order tets keep their corners: their other nodes are dropped.
+    v.compact_unreferenced = opts.compact || m.read.high_order_tets;
+    v.fix_orientation_hint = "pass --fix-orientation";
+    v.compact_hint = "pass --compact";
     m.validation = validate_mesh(m.mesh, v);
     if (const Ordering o = parse_ordering(opts.ordering); o != Ordering::Input) {
         m.new_of_old = vertex_ordering(m.mesh, o);
@@ -255,27 +265,24 @@ std::vector<double> read_vectors(const std::string& path, index_t count) {
 
 namespace {
 
-// Writes via stdio so that %.17g is exact; throws Error on any failure.
-template <class Body>
-void write_file(const std::string& path, Body body) {
-    std::FILE* f = std::fopen(path.c_str(), "w");
-    if (!f) throw Error(path + ": cannot write file: " + std::strerror(errno));
-    body(f);
-    const bool failed = std::ferror(f) != 0;
-    if (std::fclose(f) != 0 || failed) throw Error(path + ": write failed");
+// %.17g (exact) lines through an OutputFile: written whole or not at all;
+// throws IoError naming the file on any failure.
+void write_lines(const std::string& path, const double* v, std::size_t n, std::size_t per_line) {
+    OutputFile f(path);
+    char line[96];
+    for (std::size_t i = 0; i + per_line <= n; i += per_line) {
+        const int len = per_line == 3 ? std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", v[i], v[i + 1], v[i + 2])
+                                      : std::snprintf(line, sizeof line, "%.17g\n", v[i]);
+        f.write(std::string_view(line, static_cast<std::size_t>(len)));
+    }
+    f.commit();
 }
 
 }  // namespace
 
-void write_vectors(const std::string& path, const std::vector<double>& v) {
-    write_file(path, [&](std::FILE* f) {
-        for (std::size_t i = 0; i + 2 < v.size(); i += 3) std::fprintf(f, "%.17g %.17g %.17g\n", v[i], v[i + 1], v[i + 2]);
-    });
-}
+void write_vectors(const std::string& path, const std::vector<double>& v) { write_lines(path, v.data(), v.size(), 3); }
 
-void write_scalar(const std::string& path, double value) {
-    write_file(path, [&](std::FILE* f) { std::fprintf(f, "%.17g\n", value); });
-}
+void write_scalar(const std::string& path, double value) { write_lines(path, &value, 1, 1); }
 
 std::string fmt(double value, int digits) {
     char buf[64];

@@ -1,8 +1,13 @@
 // edgefem: command-line front end of the edgefem library. Every error is one
-// line "edgefem: error: <message>" on stderr and exit code 2, or 3 when a
-// simulation fails (a SimulationError: unstable step, failed solve).
+// line "edgefem: error: <message>" on stderr and exit code 2, 3 when a
+// simulation fails (a SimulationError: unstable step, failed solve), or 4
+// when a file cannot be written (an IoError or a filesystem error: disk
+// full, no permission, a file where a folder should be).
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <new>
 #include <string>
 
@@ -10,6 +15,7 @@
 
 #include "common.hpp"
 #include "evidence_commands.hpp"
+#include "edgefem/core/error.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "sim_common.hpp"
 
@@ -17,11 +23,16 @@ namespace {
 
 constexpr int kErrorExit = 2;
 constexpr int kSimulationFailedExit = 3;
+constexpr int kIoErrorExit = 4;
 
-int fail(std::string message, int code = kErrorExit) {
-    // One line, whatever the message holds.
+int fail(const std::string& text, int code = kErrorExit) {
+    // One line of printable text (no terminal escape codes, no 100 MB path),
+    // whatever the message holds.
+    std::string message = edgefem::printable(text);
     for (char& c : message)
-        if (c == '\n' || c == '\r') c = ' ';
+        if (c == '\n') c = ' ';
+    constexpr std::size_t kMaxMessage = 4000;
+    if (message.size() > kMaxMessage) message = message.substr(0, kMaxMessage) + "...";
     std::fprintf(stderr, "edgefem: error: %s\n", message.c_str());
     return code;
 }
@@ -33,6 +44,16 @@ int main(int argc, char** argv) {
                  ": edge-based StVK tetrahedral FEM (Kikuuwe et al. 2009) and the per-tet baseline",
                  "edgefem"};
     app.set_version_flag("--version", EDGEFEM_VERSION);
+    // A write past the file size limit (ulimit -f) is an error to report
+    // (EFBIG), not a signal that kills the program mid-frame.
+    std::signal(SIGXFSZ, SIG_IGN);
+    bool no_memory_check = false;
+    app.add_flag("--no-memory-check", no_memory_check,
+                 "Build models even when their estimated memory (1000 bytes per tet) exceeds what is available "
+                 "(same as EDGEFEM_NO_MEMORY_CHECK=1)");
+    // Set before anything runs: the subcommands' callbacks run inside parse().
+    for (int i = 1; i < argc && argv[i][0] == '-'; ++i)
+        if (std::string(argv[i]) == "--no-memory-check") ::setenv("EDGEFEM_NO_MEMORY_CHECK", "1", 1);
     app.require_subcommand(1);
     // Subcommands inherit this footer when they are added: those without a
     // MESH (simulate, static, stress, accuracy) set their own.
@@ -45,7 +66,8 @@ int main(int argc, char** argv) {
         "  edgefem bench box:10x5x4 --kernel force --method tet\n"
         "  edgefem simulate examples/scenes/cantilever.json --out cantilever-out\n"
         "Errors print one line 'edgefem: error: ...' to stderr. Exit codes: 0 ok, 2 bad input,\n"
-        "3 simulation failed (unstable step or failed solve; the message names the step and vertex).");
+        "3 simulation failed (unstable step or failed solve; the message names the step and vertex),\n"
+        "4 a file could not be written (the message names it).");
     edgefem::cli::add_info_command(app);
     edgefem::cli::add_forces_command(app);
     edgefem::cli::add_bench_command(app);
@@ -70,6 +92,11 @@ int main(int argc, char** argv) {
         return fail(e.what());
     } catch (const edgefem::SimulationError& e) {
         return fail(std::string("simulation failed: ") + e.what(), kSimulationFailedExit);
+    } catch (const edgefem::IoError& e) {
+        return fail(e.what(), kIoErrorExit);
+    } catch (const std::filesystem::filesystem_error& e) {
+        // e.what() is "filesystem error: <op>: <reason> [<path>]".
+        return fail(std::string(e.what()), kIoErrorExit);
     } catch (const std::bad_alloc&) {
         // A bare "std::bad_alloc" names nothing.
         return fail("out of memory (the input needs more memory than is available: try a smaller mesh)");

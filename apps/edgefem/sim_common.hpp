@@ -23,18 +23,26 @@ SceneFile load_scene_file(const std::string& path);
 // the strain energy density of every tet.
 class FrameWriter {
 public:
-    explicit FrameWriter(const Scene& scene);
+    // `file_vertex` (SceneFile::file_vertex): when not empty, every frame
+    // carries it as the point field "file_vertex".
+    explicit FrameWriter(const Scene& scene, std::vector<index_t> file_vertex = {});
     void write(const std::string& path, std::span<const double> u, std::span<const double> f);
 
 private:
     const Mesh& mesh_;
+    std::vector<index_t> file_vertex_;
     std::optional<TetModel<double>> tets_;  // FE only: the SN energy is not per tet
     std::vector<double> density_;
 };
 
-// Exit codes: 0 ok, 2 bad input (any edgefem::Error but a SimulationError),
-// 3 a SimulationError (main.cpp maps them).
-inline constexpr const char* kExitCodesHelp = "Exit codes: 0 ok, 2 bad input, 3 simulation failed.";
+// Writes SceneFile::file_vertex to `path`: a "# edgefem vertex map" line,
+// then one line per output vertex with its 0-based index in the mesh file.
+void write_vertex_map(const std::string& path, const std::vector<index_t>& file_vertex);
+
+// Exit codes: 0 ok, 2 bad input (any edgefem::Error but those below),
+// 3 a SimulationError, 4 an IoError or filesystem error (main.cpp maps them).
+inline constexpr const char* kExitCodesHelp =
+    "Exit codes: 0 ok, 2 bad input, 3 simulation failed, 4 a file could not be written.";
 
 void add_simulate_command(CLI::App& app);
 void add_static_command(CLI::App& app);

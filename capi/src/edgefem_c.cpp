@@ -114,7 +114,11 @@ edgefem_status make_scene(const char* fn, edgefem_scene** out, edgefem::Mesh (*b
     return guard(fn, [&] {
         require(out, "out");
         edgefem::Mesh mesh = build(ctx);
-        edgefem::validate_mesh(mesh);
+        // The C API has neither option: its messages must not suggest them.
+        edgefem::ValidationOptions options;
+        options.fix_orientation_hint = "reorder their vertices before passing the mesh (the C API does not reorient)";
+        options.compact_hint = "leave them out of the arrays passed";
+        edgefem::validate_mesh(mesh, options);
         *out = new edgefem_scene{default_scene_for(std::move(mesh))};
     }, invalid_status);
 }

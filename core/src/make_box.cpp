@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/memory_estimate.hpp"
 
 namespace edgefem {
 
@@ -36,6 +37,10 @@ Mesh make_box(index_t nx, index_t ny, index_t nz, double cell) {
                       (nv * 3 * sizeof(double) + nt * 4 * sizeof(index_t)) / 1e9);
         throw InvalidArgument(buf);
     }
+    // Under the limit a box can still need far more memory than the machine
+    // has (2^28 tets: about 270 GB to simulate): said before allocating.
+    check_memory("box of " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) + " cells",
+                 static_cast<std::int64_t>(nt));
 
     Mesh mesh;
     const index_t sx = nx + 1, sy = ny + 1;

@@ -1,6 +1,6 @@
 // Gmsh MSH 2.2 and 4.1 ASCII reader. Nodes keep file order and may have any
-// positive, non-contiguous tags. 4-node tets are read; 10-node tets keep
-// their 4 corners (Gmsh lists the corners first). Other volume elements are
+// positive, non-contiguous tags. 4-node tets are read; 10-, 20-, 35- and
+// 56-node tets keep their 4 corners (Gmsh lists the corners first). Other volume elements are
 // an error (simulating the tets alone would drop part of the body); point,
 // line and surface elements are boundary markup, skipped and counted. Tets
 // are resolved against the node tags once the whole file is read, so
@@ -21,11 +21,19 @@ namespace edgefem {
 
 namespace {
 
-constexpr int kTetType = 4;
-constexpr int kTet10Type = 11;
-
-// Nodes of an element type read as a tet, or 0.
-int tet_node_count(std::int64_t type) { return type == kTetType ? 4 : type == kTet10Type ? 10 : 0; }
+// Nodes of an element type read as a tet (Gmsh lists a tet's 4 corners
+// first at every order: 4, 11 quadratic, 29 cubic, 30 quartic, 31 quintic),
+// or 0.
+int tet_node_count(std::int64_t type) {
+    switch (type) {
+        case 4: return 4;
+        case 11: return 10;
+        case 29: return 20;
+        case 30: return 35;
+        case 31: return 56;
+        default: return 0;
+    }
+}
 
 // Dimension of an element type (Gmsh's GmshDefines.h), -1 when unknown.
 int element_dimension(std::int64_t type) {
@@ -60,6 +68,9 @@ std::string element_type_name(std::int64_t type) {
         {17, "20-node hexahedron"},
         {18, "15-node prism"},
         {19, "13-node pyramid"},
+        {29, "20-node tetrahedron"},
+        {30, "35-node tetrahedron"},
+        {31, "56-node tetrahedron"},
     };
     const auto it = names.find(type);
     return it == names.end() ? "element" : it->second;
@@ -77,7 +88,8 @@ struct GmshData {
     std::map<std::int64_t, std::int64_t> skipped;                      // type -> count
     std::map<std::int64_t, std::int64_t> volume_skipped;               // type -> count: an error
     std::int64_t first_volume_line = 0;                                // of the first volume element skipped
-    std::vector<std::pair<std::int64_t, std::size_t>> mid_nodes;       // 10-node tets: (tag, tet)
+    std::vector<std::pair<std::int64_t, std::size_t>> mid_nodes;       // higher-order tets: (tag, tet)
+    std::map<int, std::int64_t> high_order;                            // nodes per tet -> tets
 };
 
 std::int64_t single_int(detail::TextReader& r, const std::string& what) {
@@ -119,13 +131,14 @@ void add_node(detail::TextReader& r, GmshData& d, std::int64_t tag, std::int64_t
     d.node_tag_line.push_back(tag_line);
 }
 
-// Reads the nodes of a 4- or 10-node tet; the mid-edge nodes of the latter
+// Reads the nodes of a tet of any order; the nodes past the corners
 // are only checked to exist (the corners come first).
 void add_tet(detail::TextReader& r, GmshData& d, std::int64_t tag, detail::LineTokens& tk,
              int nodes, int region, int entity_dim, std::int64_t entity) {
     const std::size_t t = d.mesh.source.tet_id.size();
     for (int k = 0; k < 4; ++k) d.tet_nodes.push_back(r.next_int(tk, "tet node tag"));
     for (int k = 4; k < nodes; ++k) d.mid_nodes.emplace_back(r.next_int(tk, "tet node tag"), t);
+    if (nodes > 4) ++d.high_order[nodes];
     r.expect_end(tk, "the " + std::to_string(nodes) + " nodes of tetrahedron " + std::to_string(tag));
     d.mesh.region.push_back(region);
     d.mesh.source.tet_line.push_back(r.line_no());
@@ -153,7 +166,6 @@ std::string summary(const std::map<std::int64_t, std::int64_t>& counts) {
 
 void read_nodes_22(detail::TextReader& r, GmshData& d) {
     const index_t n = r.check_count(single_int(r, "the node count"), 4, "node");
-    d.mesh.X.reserve(3 * static_cast<std::size_t>(n));
     for (index_t i = 0; i < n; ++i) {
         r.require_line("node " + std::to_string(i + 1) + " of " + std::to_string(n));
         auto tk = r.tokens();
@@ -225,7 +237,6 @@ void read_nodes_41(detail::TextReader& r, GmshData& d) {
     r.expect_end(header, "the node block header");
     const index_t nb = r.check_count(nblocks, 4, "node block");
     const index_t n = r.check_count(nnodes, 4, "node");
-    d.mesh.X.reserve(3 * static_cast<std::size_t>(n));
     std::int64_t total = 0;
     std::vector<std::pair<std::int64_t, std::int64_t>> tags;  // (tag, line) of one block
     for (index_t b = 0; b < nb; ++b) {
@@ -445,9 +456,13 @@ Mesh read_gmsh(const std::string& path, ReadReport* report) {
         for (const auto& [type, count] : d.skipped) report->skipped_elements += count;
         if (!report->skipped_summary.empty() && !d.skipped.empty()) report->skipped_summary += ", ";
         report->skipped_summary += summary(d.skipped);
-        if (!d.mid_nodes.empty())
+        std::string kinds;
+        for (const auto& [nodes, count] : d.high_order)
+            kinds += (kinds.empty() ? "" : ", ") + std::to_string(count) + " x " + std::to_string(nodes) + "-node";
+        report->high_order_tets = report->high_order_tets || !d.high_order.empty();
+        if (!d.high_order.empty())
             report->warnings.push_back(
-                path + ": 10-node tets: kept the 4 corner nodes; the mid-edge nodes are left "
+                path + ": higher-order tets (" + kinds + "): kept the 4 corner nodes; the other nodes are left "
                        "unreferenced (validate_mesh with compact_unreferenced removes them)");
     }
     return std::move(d.mesh);

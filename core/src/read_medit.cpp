@@ -82,25 +82,22 @@ void read_tets(detail::TextReader& r, Words& words, int nodes, Mesh& mesh, TetSe
     const auto first = static_cast<index_t>(tets.raw.size() / 4);
     if (std::int64_t{first} + n > std::numeric_limits<index_t>::max())
         r.fail("the tet sections hold more than 2^31-1 tets");
-    tets.raw.resize(4 * (static_cast<std::size_t>(first) + n));
-    mesh.region.resize(first + n);
-    src.tet_line.resize(first + n);
-    src.tet_id.resize(first + n);
+    // Grown line by line, never sized from the count (a count the file does
+    // not back costs nothing).
     for (index_t i = 0; i < n; ++i) {
         const index_t t = first + i;
         r.require_line("tet " + std::to_string(i + 1) + " of " + std::to_string(n));
         auto tk = r.tokens();
-        for (int k = 0; k < 4; ++k)
-            tets.raw[4 * static_cast<std::size_t>(t) + k] = r.next_int(tk, "vertex index");
+        for (int k = 0; k < 4; ++k) tets.raw.push_back(r.next_int(tk, "vertex index"));
         for (int k = 4; k < nodes; ++k) tets.mid.emplace_back(r.next_int(tk, "vertex index"), t);
         std::int64_t ref = 0;
         if (!tk.empty()) ref = r.next_int(tk, "tet reference");
         r.expect_end(tk, "tet " + std::to_string(i + 1));
         if (ref < std::numeric_limits<int>::min() || ref > std::numeric_limits<int>::max())
             r.fail("tet reference " + std::to_string(ref) + " does not fit an int");
-        mesh.region[t] = static_cast<int>(ref);
-        src.tet_line[t] = r.line_no();
-        src.tet_id[t] = i + 1;  // numbered within its section
+        mesh.region.push_back(static_cast<int>(ref));
+        src.tet_line.push_back(r.line_no());
+        src.tet_id.push_back(i + 1);  // numbered within its section
     }
 }
 
@@ -131,21 +128,19 @@ void read_vertices(detail::TextReader& r, Words& words, Mesh& mesh) {
     auto& src = mesh.source;
     const index_t n = r.check_count(words.next_int("the vertex count"), 3, "vertex");
     words.end_of_header("the vertex count");
-    mesh.X.resize(3 * static_cast<std::size_t>(n));
-    src.vertex_line.resize(n);
-    src.vertex_id.resize(n);
     for (index_t v = 0; v < n; ++v) {
         r.require_line("vertex " + std::to_string(v + 1) + " of " + std::to_string(n));
         auto tk = r.tokens();
-        double* p = &mesh.X[3 * static_cast<std::size_t>(v)];
+        double p[3];
         p[0] = r.next_double(tk, "x coordinate");
         p[1] = r.next_double(tk, "y coordinate");
         p[2] = r.next_double(tk, "z coordinate");
         if (!tk.empty()) r.next_int(tk, "vertex reference");
         r.expect_end(tk, "vertex " + std::to_string(v + 1));
-        src.vertex_line[v] = r.line_no();
-        src.vertex_id[v] = v + 1;
         detail::check_finite(r, p, v, v + 1);
+        mesh.X.insert(mesh.X.end(), p, p + 3);
+        src.vertex_line.push_back(r.line_no());
+        src.vertex_id.push_back(v + 1);
     }
 }
 
@@ -231,6 +226,7 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
     if (report) {
         if (!report->skipped_summary.empty() && !skipped.empty()) report->skipped_summary += ", ";
         report->skipped_summary += summary(skipped);
+        report->high_order_tets = report->high_order_tets || tets.have_p2;
         if (tets.have_p2)
             report->warnings.push_back(
                 path + ": TetrahedraP2: kept the 4 corner nodes; the mid-edge nodes are left "

@@ -87,20 +87,17 @@ std::int64_t read_node_file(const std::string& file, Mesh& mesh) {
         r.fail("boundary marker flag must be 0 or 1, got " + std::to_string(nmark));
     const index_t nv = r.check_count(n, static_cast<int>(4 + nattr + nmark), "vertex");
 
-    mesh.X.resize(3 * static_cast<std::size_t>(nv));
+    // Grown line by line, never sized from the header's count: a count the
+    // file does not back costs nothing before the short line is found.
     auto& src = mesh.source;
     src.vertex_file = file;
-    src.vertex_line.resize(nv);
-    src.vertex_id.resize(nv);
     std::int64_t base = 0;
     for (index_t v = 0; v < nv; ++v) {
         r.require_line("vertex " + std::to_string(v + 1) + " of " + std::to_string(nv));
         auto tk = r.tokens();
         const std::int64_t id = r.next_int(tk, "vertex number");
         base = check_number(r, id, v, base, src.vertex_line, "vertex");
-        src.vertex_line[v] = r.line_no();
-        src.vertex_id[v] = id;
-        double* p = &mesh.X[3 * static_cast<std::size_t>(v)];
+        double p[3];
         p[0] = r.next_double(tk, "x coordinate");
         p[1] = r.next_double(tk, "y coordinate");
         p[2] = r.next_double(tk, "z coordinate");
@@ -108,6 +105,9 @@ std::int64_t read_node_file(const std::string& file, Mesh& mesh) {
         if (nmark) r.next_int(tk, "boundary marker");
         r.expect_end(tk, "the values the header declares for vertex " + std::to_string(id));
         detail::check_finite(r, p, v, id);
+        mesh.X.insert(mesh.X.end(), p, p + 3);
+        src.vertex_line.push_back(r.line_no());
+        src.vertex_id.push_back(id);
     }
     if (r.next_line())
         r.fail("more vertex lines than the header's count " + std::to_string(nv));
@@ -130,21 +130,18 @@ void read_ele_file(const std::string& file, std::int64_t base, Mesh& mesh, ReadR
 
     auto& src = mesh.source;
     src.tet_file = file;
-    src.tet_line.resize(nt);
-    src.tet_id.resize(nt);
-    std::vector<std::int64_t> raw(4 * static_cast<std::size_t>(nt));
-    if (nattr > 0) mesh.region.resize(nt);
+    std::vector<std::int64_t> raw;  // grown line by line, as the vertices
     std::int64_t tet_base = 0;
     for (index_t t = 0; t < nt; ++t) {
         r.require_line("tet " + std::to_string(t + 1) + " of " + std::to_string(nt));
         auto tk = r.tokens();
         const std::int64_t id = r.next_int(tk, "tet number");
         tet_base = check_number(r, id, t, tet_base, src.tet_line, "tet");
-        src.tet_line[t] = r.line_no();
-        src.tet_id[t] = id;
+        src.tet_line.push_back(r.line_no());
+        src.tet_id.push_back(id);
         for (std::int64_t k = 0; k < npt; ++k) {
             const std::int64_t v = r.next_int(tk, "vertex index");
-            if (k < 4) raw[4 * static_cast<std::size_t>(t) + k] = v;
+            if (k < 4) raw.push_back(v);
             // Mid-edge nodes are range-checked here, as they are not kept.
             if (k >= 4 && (v < base || v - base >= mesh.num_vertices()))
                 r.fail(detail::item_label("tet", t, id) + ": vertex index " + std::to_string(v) +
@@ -153,12 +150,13 @@ void read_ele_file(const std::string& file, std::int64_t base, Mesh& mesh, ReadR
         }
         for (std::int64_t a = 0; a < nattr; ++a) {
             const double value = r.next_double(tk, "tet attribute");
-            if (a == 0) mesh.region[t] = detail::region_from_attribute(r, value);
+            if (a == 0) mesh.region.push_back(detail::region_from_attribute(r, value));
         }
         r.expect_end(tk, "the values the header declares for tet " + std::to_string(id));
     }
     if (r.next_line()) r.fail("more tet lines than the header's count " + std::to_string(nt));
     mesh.tets = detail::resolve_tets(file, raw, base, mesh.num_vertices(), src.tet_line, src.tet_id);
+    if (npt == 10 && report) report->high_order_tets = true;
     if (npt == 10 && report)
         report->warnings.push_back(
             file + ": 10-node tets: kept the 4 corner nodes; the mid-edge nodes are left "

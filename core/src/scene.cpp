@@ -46,9 +46,8 @@ void Scene::validate() const {
         for (const index_t v : mesh.tets) used[v] = 1;
         for (index_t v = 0; v < nv; ++v)
             if (!used[v])
-                bad("mesh", mesh.describe_vertex(v) + " is used by no tet (it would have no mass); remove unreferenced "
-                    "vertices with the compact option (ValidationOptions::compact_unreferenced, CLI --compact, "
-                    "scene mesh_options.compact)");
+                bad("mesh", mesh.describe_vertex(v) + " is used by no tet (it would have no mass); remove the vertices "
+                    "no tet uses from the mesh (in C++: validate_mesh with ValidationOptions::compact_unreferenced)");
     }
     // Enums that came in as integers (bindings, casts) must name a value.
     if (model != ModelKind::FE && model != ModelKind::SN) bad("model", "not a model (fe or sn)");
@@ -89,6 +88,8 @@ void Scene::validate() const {
             "> 0 applies only to the semi-implicit integrator with the cg solver (Newton's solves run to their tolerance)");
     if (!std::isfinite(solver.max_energy_growth) || (solver.max_energy_growth != 0 && !(solver.max_energy_growth >= 1)))
         bad("solver.max_energy_growth", "must be 0 (off) or a finite number >= 1, got " + std::to_string(solver.max_energy_growth));
+    if (solver.fail_on_inverted && !count_inverted_tets)
+        bad("solver.fail_on_inverted", "needs count_inverted_tets (the inverted tets are not counted otherwise)");
     std::vector<char> seen(nv, 0);
     for (std::size_t i = 0; i < fixed.size(); ++i) {
         if (fixed[i] < 0 || fixed[i] >= nv)

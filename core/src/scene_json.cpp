@@ -16,6 +16,7 @@
 
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
+#include "edgefem/core/memory_estimate.hpp"
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "text_reader.hpp"
@@ -72,7 +73,7 @@ struct Context {
     std::string base_dir;
 
     [[noreturn]] void fail(const std::string& key, const std::string& message) const {
-        throw InvalidArgument(source + ": \"" + key + "\": " + message);
+        throw InvalidArgument(printable(source) + ": \"" + printable(key) + "\": " + printable(message));
     }
 
     std::string resolve(const std::string& p) const {
@@ -185,15 +186,21 @@ Mesh box_from_spec(const Context& cx, const std::string& spec, const std::string
     }
 }
 
-Mesh read_scene_mesh(const Context& cx, const json& v, std::vector<std::string>& warnings) {
+// The scene's mesh; `report` gets what the reader noticed (warnings, the
+// file's own materials, higher-order tets).
+Mesh read_scene_mesh(const Context& cx, const json& v, ReadReport& report) {
     const std::string key = "mesh";
     try {
         if (v.is_string()) {
             const std::string s = get_string(cx, v, key);
             if (is_box_spec(s)) return box_from_spec(cx, s, key);
-            ReadReport report;
-            Mesh m = read_mesh(cx.resolve(s), MeshFormat::Auto, &report);
-            warnings.insert(warnings.end(), report.warnings.begin(), report.warnings.end());
+            const std::string path = cx.resolve(s);
+            Mesh m = read_mesh(path, MeshFormat::Auto, &report);
+            try {
+                check_memory(path, m.num_tets());
+            } catch (const InvalidArgument& e) {
+                cx.fail(key, e.what());
+            }
             return m;
         }
         check_keys(cx, v, key, {"box"});
@@ -362,7 +369,8 @@ void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     check_keys(cx, v, p,
                {"linear", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "definite_stiffness",
                 "newton_tolerance", "newton_max_iterations", "load_steps", "max_step_halvings",
-                "stiffness_interval", "fail_on_unconverged", "max_energy_growth"});
+                "stiffness_interval", "fail_on_unconverged", "max_energy_growth", "fail_on_inverted"});
+    if (const json* x = find(v, "fail_on_inverted")) s.fail_on_inverted = get_bool(cx, *x, join(p, "fail_on_inverted"));
     if (const json* x = find(v, "linear"))
         s.linear_solver = get_enum<LinearSolver>(cx, *x, join(p, "linear"), {{"cg", LinearSolver::CG}, {"direct", LinearSolver::Direct}});
     if (const json* x = find(v, "cg_tolerance")) s.cg_tolerance = get_number(cx, *x, join(p, "cg_tolerance"), Range::Positive);
@@ -417,6 +425,8 @@ SceneFile parse(const Context& cx, const json& root) {
 
     // The mesh first: the selectors need it.
     ValidationOptions vopt;
+    vopt.fix_orientation_hint = "set mesh_options.fix_orientation";
+    vopt.compact_hint = "set mesh_options.compact";
     if (const json* o = find(root, "mesh_options")) {
         check_keys(cx, *o, "mesh_options", {"fix_orientation", "compact"});
         if (const json* x = find(*o, "fix_orientation")) vopt.fix_orientation = get_bool(cx, *x, "mesh_options.fix_orientation");
@@ -424,16 +434,45 @@ SceneFile parse(const Context& cx, const json& root) {
     }
     const json* mesh = find(root, "mesh");
     if (!mesh) cx.fail("mesh", "required key missing");
-    s.mesh = read_scene_mesh(cx, *mesh, sf.warnings);
+    ReadReport read;
+    s.mesh = read_scene_mesh(cx, *mesh, read);
+    sf.warnings.insert(sf.warnings.end(), read.warnings.begin(), read.warnings.end());
+    // Higher-order tets keep their corners: the other nodes, unreferenced,
+    // are dropped as compact would (the file's numbering stays that of
+    // selections, and file_vertex maps the output back to it).
+    if (read.high_order_tets) vopt.compact_unreferenced = true;
     const Renumbering renumber = compaction_map(s.mesh, vopt.compact_unreferenced);
     try {
         const ValidationReport report = validate_mesh(s.mesh, vopt);
         sf.warnings.insert(sf.warnings.end(), report.warnings.begin(), report.warnings.end());
+        if (report.unreferenced_vertices > 0 && !vopt.compact_unreferenced) {
+            std::vector<char> used(s.mesh.num_vertices(), 0);
+            for (const index_t v : s.mesh.tets) used[v] = 1;
+            const auto first = std::find(used.begin(), used.end(), 0) - used.begin();
+            cx.fail("mesh", s.mesh.describe_vertex(static_cast<index_t>(first)) + " is used by no tet (it would have no mass; " +
+                                std::to_string(report.unreferenced_vertices) +
+                                " such vertices in all); set mesh_options.compact to remove them");
+        }
     } catch (const MeshError& e) {
         throw MeshError(cx.source + ": \"mesh\": " + e.what(), {}, 0, e.element());
     }
+    if (!renumber.to_final.empty() && s.mesh.num_vertices() < renumber.read_count) {
+        sf.file_vertex.resize(s.mesh.num_vertices());
+        for (index_t v = 0; v < renumber.read_count; ++v)
+            if (renumber.to_final[v] >= 0) sf.file_vertex[renumber.to_final[v]] = v;
+    }
 
     if (const json* x = find(root, "material")) s.materials.fallback = read_material(cx, *x, "material", Material{});
+    // The mesh file's own materials (Vega *MATERIAL / *REGION) hold for their
+    // regions; "regions" overrides them.
+    if (!read.materials.empty()) {
+        std::string list;
+        for (const auto& [region, m] : read.materials) {
+            s.materials.by_region[region] = m;
+            list += (list.empty() ? "" : ", ") + std::to_string(region) + " (" + read.material_names[region] + ")";
+        }
+        sf.warnings.push_back(cx.source + ": \"mesh\": the mesh file's materials are used for regions " + list);
+    }
     if (const json* x = find(root, "regions")) {
         if (!x->is_object()) cx.fail("regions", "expected an object {\"<region id>\": {material}, ...}, got " + show(*x));
         std::set<int> present;
@@ -443,8 +482,8 @@ SceneFile parse(const Context& cx, const json& root) {
             int region = 0;
             const auto [end, ec] = std::from_chars(id.data(), id.data() + id.size(), region);
             if (ec != std::errc() || end != id.data() + id.size()) cx.fail(key, "region ids are integers, got \"" + id + "\"");
-            // Unset fields come from "material".
-            s.materials.by_region[region] = read_material(cx, m, key, s.materials.fallback);
+            // Unset fields come from the mesh file's material for the region, else "material".
+            s.materials.by_region[region] = read_material(cx, m, key, s.materials.of(region));
             if (!present.count(region))
                 sf.warnings.push_back(cx.source + ": \"" + key + "\": no tet of the mesh has region " + id);
         }
@@ -505,18 +544,28 @@ class CappedDomBuilder {
 public:
     explicit CappedDomBuilder(json& root) : dom_(root, /*allow_exceptions=*/false) {}
 
-    bool null() { return dom_.null(); }
-    bool boolean(bool v) { return dom_.boolean(v); }
-    bool number_integer(json::number_integer_t v) { return dom_.number_integer(v); }
-    bool number_unsigned(json::number_unsigned_t v) { return dom_.number_unsigned(v); }
-    bool number_float(json::number_float_t v, const std::string& s) { return dom_.number_float(v, s); }
-    bool string(json::string_t& v) { return dom_.string(v); }
-    bool binary(json::binary_t& v) { return dom_.binary(v); }
-    bool key(json::string_t& v) { return dom_.key(v); }
-    bool start_object(std::size_t n) { return enter() && dom_.start_object(n); }
-    bool start_array(std::size_t n) { return enter() && dom_.start_array(n); }
-    bool end_object() { --depth_; return dom_.end_object(); }
-    bool end_array() { --depth_; return dom_.end_array(); }
+    bool null() { return value() && dom_.null(); }
+    bool boolean(bool v) { return value() && dom_.boolean(v); }
+    bool number_integer(json::number_integer_t v) { return value() && dom_.number_integer(v); }
+    bool number_unsigned(json::number_unsigned_t v) { return value() && dom_.number_unsigned(v); }
+    bool number_float(json::number_float_t v, const std::string& s) { return value() && dom_.number_float(v, s); }
+    bool string(json::string_t& v) { return value() && dom_.string(v); }
+    bool binary(json::binary_t& v) { return value() && dom_.binary(v); }
+    // A key given twice would silently keep one value ({"steps": 3, "steps": 5}).
+    bool key(json::string_t& v) {
+        Level& level = levels_.back();
+        if (!level.keys.insert(v).second) {
+            level.key = v;
+            duplicate_ = path();
+            return false;
+        }
+        level.key = v;
+        return dom_.key(v);
+    }
+    bool start_object(std::size_t n) { return value() && enter(true) && dom_.start_object(n); }
+    bool start_array(std::size_t n) { return value() && enter(false) && dom_.start_array(n); }
+    bool end_object() { leave(); return dom_.end_object(); }
+    bool end_array() { leave(); return dom_.end_array(); }
     template <class Exception>
     bool parse_error(std::size_t offset, const std::string& /*token*/, const Exception& e) {
         offset_ = offset;
@@ -525,16 +574,45 @@ public:
     }
 
     bool too_deep() const { return too_deep_; }
+    // The key path of a duplicate key ("solver.cg_tolerance"), or "".
+    const std::string& duplicate() const { return duplicate_; }
     std::size_t offset() const { return offset_; }
     const std::string& message() const { return message_; }
 
 private:
-    bool enter() {
+    // An open object (its keys so far, the current one) or array (the
+    // index of its next element).
+    struct Level {
+        bool object;
+        std::set<std::string> keys;
+        std::string key;
+        std::size_t index = 0;
+    };
+
+    // A value starts: an array counts its elements.
+    bool value() {
+        if (!levels_.empty() && !levels_.back().object) ++levels_.back().index;
+        return true;
+    }
+    bool enter(bool object) {
         too_deep_ = ++depth_ > kMaxDepth;
+        if (!too_deep_) levels_.push_back({object, {}, {}, 0});
         return !too_deep_;
+    }
+    void leave() {
+        --depth_;
+        if (!levels_.empty()) levels_.pop_back();
+    }
+    std::string path() const {
+        std::string out;
+        for (const Level& l : levels_)
+            out = l.object ? join(out, l.key) : item(out, l.index - 1);
+        return out;
     }
 
     nlohmann::detail::json_sax_dom_parser<json> dom_;
+    std::vector<Level> levels_;
+    std::string duplicate_;
     int depth_ = 0;
     bool too_deep_ = false;
     std::size_t offset_ = 0;
@@ -560,6 +638,8 @@ json parse_json(const std::string& text, const std::string& source) {
         return root;
     if (sax.too_deep())
         throw InvalidArgument(source + ": invalid JSON: nested deeper than " + std::to_string(kMaxDepth) + " levels");
+    if (!sax.duplicate().empty())
+        throw InvalidArgument(printable(source) + ": \"" + printable(sax.duplicate()) + "\": duplicate key (each key may appear once)");
     // Drop nlohmann's "[json.exception.parse_error.101] " tag; its parse
     // errors say where they are, its other errors do not.
     std::string what = sax.message();

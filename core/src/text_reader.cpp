@@ -226,9 +226,16 @@ std::vector<index_t> resolve_tets(const std::string& file, const std::vector<std
 }
 
 int region_from_attribute(const TextReader& reader, double value) {
+    char shown[32];
+    std::snprintf(shown, sizeof shown, "%.17g", value);
     if (!std::isfinite(value) || std::fabs(value) > std::numeric_limits<int>::max())
-        reader.fail("region attribute " + std::to_string(value) + " is not a usable region id");
-    return static_cast<int>(std::lround(value));
+        reader.fail(std::string("region attribute ") + shown + " is not a usable region id");
+    // -2.7 used to become region -3: a region id is an integer, up to the
+    // round-off of a writer that stored it as a float (0.9999999 is 1).
+    const double rounded = std::round(value);
+    if (std::fabs(value - rounded) > 1e-6 * std::max(1.0, std::fabs(value)))
+        reader.fail(std::string("region attribute ") + shown + " is not an integer (region ids are integers)");
+    return static_cast<int>(rounded);
 }
 
 std::string ascii_lower(std::string_view s) {

@@ -116,7 +116,8 @@ std::vector<index_t> resolve_tets(const std::string& file, const std::vector<std
                                   const std::vector<std::int64_t>& tet_line,
                                   const std::vector<std::int64_t>& tet_id);
 
-// Rounds a region attribute to int, failing when it is not finite or too large.
+// A region attribute as an int, failing (naming the file and line) when it
+// is not a finite integer (to 1e-6 relative: float round-off) that fits an int.
 int region_from_attribute(const TextReader& reader, double value);
 
 }  // namespace edgefem::detail

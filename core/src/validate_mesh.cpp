@@ -145,7 +145,7 @@ void handle_unreferenced(Mesh& mesh, const ValidationOptions& options, Validatio
         report.warnings.push_back(std::to_string(unused) + " of " + std::to_string(nv) +
                                   " vertices are not used by any tet (the first is " +
                                   mesh.describe_vertex(first) +
-                                  "); remove them with the compact option (ValidationOptions::compact_unreferenced, CLI --compact, scene mesh_options.compact)");
+                                  "); to remove them, " + options.compact_hint);
         return;
     }
     report.warnings.push_back("removed " + std::to_string(unused) +
@@ -216,10 +216,11 @@ std::vector<index_t> check_all_but_orientation(const Mesh& mesh, const Validatio
     return inverted;
 }
 
-[[noreturn]] void throw_inverted(const Mesh& mesh, const std::vector<index_t>& inverted) {
+[[noreturn]] void throw_inverted(const Mesh& mesh, const std::vector<index_t>& inverted,
+                                 const ValidationOptions& options) {
     throw MeshError(std::to_string(inverted.size()) + " of " + std::to_string(mesh.num_tets()) +
                         " tets are inverted (negative volume); the first is " + mesh.describe_tet(inverted.front()) +
-                        ". Enable the fix-orientation option (ValidationOptions::fix_orientation, CLI --fix-orientation) to flip them",
+                        ". To flip them, " + options.fix_orientation_hint,
                     {}, 0, inverted.front());
 }
 
@@ -229,7 +230,7 @@ ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options) {
     const std::vector<index_t> inverted = check_all_but_orientation(mesh, options);
     ValidationReport report;
     if (!inverted.empty()) {
-        if (!options.fix_orientation) throw_inverted(mesh, inverted);
+        if (!options.fix_orientation) throw_inverted(mesh, inverted, options);
         for (const index_t t : inverted)
             std::swap(mesh.tets[4 * static_cast<std::size_t>(t) + 2],
                       mesh.tets[4 * static_cast<std::size_t>(t) + 3]);
@@ -244,7 +245,7 @@ ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options) {
 
 void check_mesh(const Mesh& mesh, const ValidationOptions& options) {
     const std::vector<index_t> inverted = check_all_but_orientation(mesh, options);
-    if (!inverted.empty()) throw_inverted(mesh, inverted);
+    if (!inverted.empty()) throw_inverted(mesh, inverted, options);
 }
 
 }  // namespace edgefem

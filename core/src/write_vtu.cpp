@@ -1,5 +1,7 @@
 // VTK XML writer. ASCII, with numbers in shortest round-trip form
 // (std::to_chars), so values read back bit-exact and files stay diffable.
+// Every file is written through an OutputFile: a failed write leaves no
+// partial file, and a .pvd is replaced in one step, never truncated.
 #include "edgefem/core/write_vtu.hpp"
 
 #include <cerrno>
@@ -10,62 +12,39 @@
 #include <string>
 
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/output_file.hpp"
 
 namespace edgefem {
 
 namespace {
 
-// Buffered output to a FILE; every failure throws Error naming the path.
+// Numbers in shortest round-trip form into an OutputFile (written whole or
+// not at all); every failure throws IoError naming the path.
 class Output {
 public:
-    explicit Output(const std::string& path) : path_(path) {
-        std::error_code ec;
-        if (std::filesystem::is_directory(path, ec))
-            throw Error("cannot write '" + path + "': it is a directory");
-        file_ = std::fopen(path.c_str(), "wb");
-        if (!file_)
-            throw Error("cannot open '" + path + "' for writing: " + std::strerror(errno));
-    }
-    ~Output() {
-        if (file_) std::fclose(file_);
-    }
-    Output(const Output&) = delete;
-    Output& operator=(const Output&) = delete;
+    explicit Output(const std::string& path) : file_(path) {}
 
     Output& operator<<(std::string_view s) {
-        buffer_ += s;
-        if (buffer_.size() > (1u << 20)) flush();
+        file_.write(s);
         return *this;
     }
     Output& operator<<(double x) { return number(x); }
     Output& operator<<(long long x) { return number(x); }
 
-    void close() {
-        flush();
-        std::FILE* f = file_;
-        file_ = nullptr;
-        if (std::fclose(f) != 0) throw Error("error while writing '" + path_ + "'");
-    }
+    void close() { file_.commit(); }
 
 private:
     template <class T>
     Output& number(T x) {
         char tmp[32];
-        const auto [end, ec] = std::to_chars(tmp, tmp + sizeof tmp, x);
-        buffer_.append(tmp, ec == std::errc() ? end : tmp);
-        buffer_ += ' ';
-        if (buffer_.size() > (1u << 20)) flush();
+        const auto [end, ec] = std::to_chars(tmp, tmp + sizeof tmp - 1, x);
+        char* last = ec == std::errc() ? end : tmp;
+        *last++ = ' ';
+        file_.write(std::string_view(tmp, static_cast<std::size_t>(last - tmp)));
         return *this;
     }
-    void flush() {
-        if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-            throw Error("error while writing '" + path_ + "': " + std::strerror(errno));
-        buffer_.clear();
-    }
 
-    std::string path_;
-    std::FILE* file_ = nullptr;
-    std::string buffer_;
+    OutputFile file_;
 };
 
 void vector_array(Output& out, const char* name, const double* data, index_t nv) {
@@ -103,11 +82,21 @@ void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& field
         << "    <Piece NumberOfPoints=\"" << std::to_string(nv) << "\" NumberOfCells=\""
         << std::to_string(nt) << "\">\n";
 
-    if (fields.displacement || fields.force) {
-        out << "      <PointData Vectors=\"" << (fields.displacement ? "displacement" : "force")
-            << "\">\n";
+    if (fields.displacement || fields.force || fields.file_vertex) {
+        out << "      <PointData";
+        if (fields.displacement || fields.force)
+            out << " Vectors=\"" << (fields.displacement ? "displacement" : "force") << "\"";
+        out << ">\n";
         if (fields.displacement) vector_array(out, "displacement", fields.displacement, nv);
         if (fields.force) vector_array(out, "force", fields.force, nv);
+        if (fields.file_vertex) {
+            out << "        <DataArray type=\"Int64\" Name=\"file_vertex\" format=\"ascii\">\n";
+            for (index_t v = 0; v < nv; ++v) {
+                out << static_cast<long long>(fields.file_vertex[v]);
+                if (v % 16 == 15 || v + 1 == nv) out << "\n";
+            }
+            out << "        </DataArray>\n";
+        }
         out << "      </PointData>\n";
     }
 

@@ -1,5 +1,7 @@
 #include "simulator/step_control.hpp"
 
+#include <string>
+
 namespace edgefem::sim {
 
 template <class S>
@@ -61,6 +63,10 @@ const StepStats& StepControl<S>::step() {
     s_.time = t_start + s_.scene.dt;  // no drift from summed halves
     ++s_.step;
     if (s_.scene.count_inverted_tets) s_.stats.inverted_tets = s_.op->inverted_tets(s_.u.data());
+    if (s_.scene.solver.fail_on_inverted && s_.stats.inverted_tets > 0)
+        throw SimulationError("step " + std::to_string(s_.step) + " ended with " + std::to_string(s_.stats.inverted_tets) +
+                                  " inverted tets (negative volume) and solver.fail_on_inverted is set",
+                              s_.step);
     return s_.stats;
 }
 

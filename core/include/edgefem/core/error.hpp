@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 
 namespace edgefem {
 
@@ -18,6 +20,18 @@ public:
 class InvalidArgument : public Error {
 public:
     using Error::Error;
+};
+
+// A file could not be written (disk full, no permission, a folder in the
+// way, ...): not bad input. The message names the file; path() is it.
+class IoError : public Error {
+public:
+    IoError(const std::string& message, std::string path)
+        : Error(message), path_(std::move(path)) {}
+    const std::string& path() const noexcept { return path_; }
+
+private:
+    std::string path_;
 };
 
 // A problem with a mesh: unreadable or malformed file, or a mesh that fails
@@ -39,5 +53,12 @@ private:
     std::int64_t element_;
     std::string reason_;
 };
+
+// Text from input (a path, a key, a token) made safe to echo in a message:
+// control characters and other bytes below 0x20 or 0x7f shown as \xHH
+// (terminal escape codes never reach a terminal raw), and every run of
+// characters without a blank longer than `max_run` cut to its first
+// `max_run` characters and "..." (a 100 MB path gives a short message).
+std::string printable(std::string_view text, std::size_t max_run = 200);
 
 }  // namespace edgefem

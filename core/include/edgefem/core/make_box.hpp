@@ -16,8 +16,11 @@ namespace edgefem {
 inline constexpr std::int64_t kMaxBoxTets = std::int64_t(1) << 28;
 
 // The box is centred at the origin. Vertex (i, j, k) has index
-// i + (NX+1) (j + (NY+1) k). Throws InvalidArgument for non-positive sizes or
-// more than kMaxBoxTets tets.
+// i + (NX+1) (j + (NY+1) k). Throws InvalidArgument for non-positive sizes,
+// more than kMaxBoxTets tets, or a box whose simulation would need more
+// memory than is available (check_memory, memory_estimate.hpp: the message
+// names the estimate and the memory available; EDGEFEM_NO_MEMORY_CHECK=1
+// overrides it), before allocating anything.
 Mesh make_box(index_t nx, index_t ny, index_t nz, double cell = 0.01);
 
 // "box:NXxNYxNZ" (cubes of 0.01 m), the spelling the CLI and scene files

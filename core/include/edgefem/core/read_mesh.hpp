@@ -5,9 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "edgefem/core/material.hpp"
 #include "edgefem/core/mesh.hpp"
 
 namespace edgefem {
@@ -19,10 +21,20 @@ struct ReadReport {
     std::int64_t skipped_elements = 0;  // point, line and surface elements skipped (Gmsh, MEDIT)
     std::string skipped_summary;        // e.g. "2 x triangle, 14 x line"
     std::vector<std::string> warnings;
+    // Materials the file itself assigns to regions (Vega *MATERIAL/*REGION:
+    // the i-th *MATERIAL is region i), with their names; empty for the other
+    // formats. load_scene uses them (a scene's "regions" override them).
+    std::map<int, Material> materials;
+    std::map<int, std::string> material_names;
+    // The file held higher-order tets (10-, 20-, 35- or 56-node): only their
+    // corners are kept, so their other nodes are left unreferenced.
+    bool high_order_tets = false;
 };
 
-// Every reader keeps the 4 corners of 10-node (quadratic) tets, whose
-// mid-edge nodes are left unreferenced, and fails on any other volume element
+// Every reader keeps the 4 corners of higher-order tets (10-node quadratic
+// in every format; in Gmsh also 20-, 35- and 56-node), whose other nodes are
+// left unreferenced (ReadReport::high_order_tets; load_scene and the CLI
+// then drop them), and fails on any other volume element
 // (hexahedra, prisms, pyramids, ...): simulating the tets alone would drop
 // part of the body. Point, line and surface elements are boundary markup:
 // they are skipped and counted in ReadReport.
@@ -32,14 +44,18 @@ struct ReadReport {
 // attributes and boundary markers are accepted; the first tet attribute, if
 // any, becomes the region.
 Mesh read_tetgen(const std::string& path, ReadReport* report = nullptr);
-// Gmsh MSH 2.2 and 4.1 ASCII: tetrahedra (types 4 and 11); the physical tag
-// becomes the region.
+// Gmsh MSH 2.2 and 4.1 ASCII: tetrahedra (types 4, 11, 29, 30, 31); the
+// physical tag becomes the region.
 Mesh read_gmsh(const std::string& path, ReadReport* report = nullptr);
 // MEDIT .mesh (ASCII): Vertices, Tetrahedra and TetrahedraP2 sections; the
 // tet reference becomes the region; other sections are skipped.
 Mesh read_medit(const std::string& path, ReadReport* report = nullptr);
-// Vega .veg: *VERTICES and *ELEMENTS (TET) sections, 1-based; material
-// sections are skipped and other element types refused.
+// Vega .veg: *VERTICES and *ELEMENTS (TET) sections, 1-based; *MATERIAL
+// (ENU: density, Young's modulus, Poisson ratio), *SET and *REGION give
+// every tet of a region's set that material: the i-th *MATERIAL becomes
+// region i and ReadReport::materials holds its constants (tets in no region
+// keep region 0, with a warning). Other material types, other element types
+// and *INCLUDE are refused; other sections are skipped with a warning.
 Mesh read_vega(const std::string& path, ReadReport* report = nullptr);
 
 // Chooses the reader from the extension (.node/.ele or an existing prefix,

@@ -59,6 +59,11 @@ struct SolverSettings {
     // fixed CG budget (StepStats::energy_growth). 0 disables it; otherwise
     // >= 1. docs/scenes.md ("Solver settings") says why 10.
     double max_energy_growth = 10;
+    // A step that ends with inverted tets (negative volume) fails with a
+    // SimulationError instead of only being counted in
+    // StepStats::inverted_tets (`edgefem static` fails the same way after
+    // writing its files). Needs Scene::count_inverted_tets.
+    bool fail_on_inverted = false;
 };
 
 // A vertex driven to a target position.

@@ -23,6 +23,11 @@ struct SceneFile {
     OutputSettings output;
     std::string path;                   // the scene file ("" for the built-in default)
     std::vector<std::string> warnings;  // mesh reader/validation notes, unused regions, ...
+    // When validation removed vertices (mesh_options.compact, or the extra
+    // nodes of higher-order tets): each scene vertex's 0-based index in the
+    // mesh file's vertex order, the numbering of the scene's selections.
+    // Empty when the scene's numbering is the file's.
+    std::vector<index_t> file_vertex;
 };
 
 // Reads and parses a scene file; relative paths in it resolve against the

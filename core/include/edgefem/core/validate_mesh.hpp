@@ -19,6 +19,12 @@ struct ValidationOptions {
     // Unreferenced vertices are a warning; with this set they are removed and
     // the tets renumbered.
     bool compact_unreferenced = false;
+    // What the messages about inverted tets and unreferenced vertices tell
+    // the caller's user to do, in the words of the interface they use (a
+    // scene: "set mesh_options.compact"; the CLI: "pass --compact"), so
+    // that no message names an option its reader lacks.
+    std::string fix_orientation_hint = "set ValidationOptions::fix_orientation";
+    std::string compact_hint = "set ValidationOptions::compact_unreferenced";
 };
 
 struct ValidationReport {

@@ -15,15 +15,22 @@ struct VtuFields {
     const double* displacement = nullptr;    // 3 * #V; written as "displacement"
     const double* force = nullptr;           // 3 * #V; written as "force"
     const double* energy_density = nullptr;  // #T strain energy per rest volume (J/m^3)
+    // #V: each vertex's 0-based index in the mesh file's vertex order, when
+    // the numbering differs from it (mesh_options.compact removed vertices);
+    // written as the point field "file_vertex".
+    const index_t* file_vertex = nullptr;
 };
 
 // Writes an UnstructuredGrid with points X + displacement (rest positions when
 // displacement is null), tets as VTK_TETRA, the region as cell data, and the
-// given fields. Throws Error when the file cannot be written.
+// given fields. The file is written whole or not at all (OutputFile): a
+// failed write leaves no partial file. Throws IoError naming the file when
+// it cannot be written.
 void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& fields = {});
 
 // A .pvd collection: add() frames as they are written, write() (also called
-// by the destructor, errors swallowed there) updates the .pvd file.
+// by the destructor, errors swallowed there) replaces the .pvd file in one
+// step (OutputFile), so a full disk or a kill leaves the previous series.
 class PvdSeries {
 public:
     explicit PvdSeries(std::string pvd_path);
