@@ -259,12 +259,32 @@ edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt) {
 edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator) {
     return guard("edgefem_scene_set_integrator", [&] {
         require(scene, "scene");
-        switch (integrator) {
-            case EDGEFEM_EXPLICIT: scene->scene.integrator = edgefem::Integrator::Explicit; break;
-            case EDGEFEM_SEMI_IMPLICIT: scene->scene.integrator = edgefem::Integrator::SemiImplicit; break;
-            case EDGEFEM_IMPLICIT: scene->scene.integrator = edgefem::Integrator::Implicit; break;
-            default: invalid("unknown integrator " + std::to_string(int(integrator)));
-        }
+        // The C values are the enum's order (integrator_names()).
+        static_assert(int(edgefem::Integrator::Implicit) == EDGEFEM_IMPLICIT &&
+                      int(edgefem::Integrator::Verlet) == EDGEFEM_VERLET);
+        const auto& names = edgefem::integrator_names();
+        if (int(integrator) < 0 || std::size_t(integrator) >= names.size())
+            invalid("unknown integrator " + std::to_string(int(integrator)));
+        scene->scene.integrator = names[std::size_t(integrator)].second;
+    });
+}
+
+edgefem_status edgefem_scene_set_newmark(edgefem_scene* scene, double beta, double gamma) {
+    return guard("edgefem_scene_set_newmark", [&] {
+        require(scene, "scene");
+        if (!(beta > 0 && beta <= 0.5)) invalid("newmark.beta must lie in (0, 1/2], got " + std::to_string(beta));
+        if (!(gamma >= 0.5 && gamma <= 1)) invalid("newmark.gamma must lie in [1/2, 1], got " + std::to_string(gamma));
+        scene->scene.integrator_parameters.newmark_beta = beta;
+        scene->scene.integrator_parameters.newmark_gamma = gamma;
+    });
+}
+
+edgefem_status edgefem_scene_set_generalized_alpha(edgefem_scene* scene, double rho_inf) {
+    return guard("edgefem_scene_set_generalized_alpha", [&] {
+        require(scene, "scene");
+        if (!(rho_inf >= 0 && rho_inf <= 1))
+            invalid("generalized_alpha.rho_inf must lie in [0, 1], got " + std::to_string(rho_inf));
+        scene->scene.integrator_parameters.rho_inf = rho_inf;
     });
 }
 

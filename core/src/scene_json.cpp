@@ -158,7 +158,7 @@ std::string get_string(const Context& cx, const json& v, const std::string& path
 
 template <class E>
 E get_enum(const Context& cx, const json& v, const std::string& path,
-           std::initializer_list<std::pair<const char*, E>> names) {
+           const std::vector<std::pair<const char*, E>>& names) {
     if (v.is_string())
         for (const auto& [name, e] : names)
             if (v.get<std::string>() == name) return e;
@@ -411,7 +411,7 @@ SceneFile parse(const Context& cx, const json& root) {
     if (!root.is_object()) throw InvalidArgument(cx.source + ": expected a JSON object at the top level, got " + show(root));
     check_keys(cx, root, "",
                {"mesh", "mesh_options", "material", "regions", "model", "method", "gravity", "damping", "fixed",
-                "prescribed", "integrator", "dt", "steps", "solver", "output"});
+                "prescribed", "integrator", "newmark", "generalized_alpha", "dt", "steps", "solver", "output"});
     SceneFile sf;
     Scene& s = sf.scene;
 
@@ -472,10 +472,18 @@ SceneFile parse(const Context& cx, const json& root) {
     }
     if (const json* x = find(root, "prescribed")) read_prescribed(cx, *x, renumber, s);
     if (const json* x = find(root, "integrator"))
-        s.integrator = get_enum<Integrator>(cx, *x, "integrator",
-                                            {{"explicit", Integrator::Explicit},
-                                             {"semi-implicit", Integrator::SemiImplicit},
-                                             {"implicit", Integrator::Implicit}});
+        s.integrator = get_enum<Integrator>(cx, *x, "integrator", integrator_names());
+    if (const json* x = find(root, "newmark")) {
+        check_keys(cx, *x, "newmark", {"beta", "gamma"});
+        auto& ip = s.integrator_parameters;
+        if (const json* b = find(*x, "beta")) ip.newmark_beta = get_number(cx, *b, "newmark.beta", Range::Positive);
+        if (const json* g = find(*x, "gamma")) ip.newmark_gamma = get_number(cx, *g, "newmark.gamma", Range::Positive);
+    }
+    if (const json* x = find(root, "generalized_alpha")) {
+        check_keys(cx, *x, "generalized_alpha", {"rho_inf"});
+        if (const json* r = find(*x, "rho_inf"))
+            s.integrator_parameters.rho_inf = get_number(cx, *r, "generalized_alpha.rho_inf", Range::NonNegative);
+    }
     if (const json* x = find(root, "dt")) s.dt = get_number(cx, *x, "dt", Range::Positive);
     if (const json* x = find(root, "steps")) s.steps = get_int(cx, *x, "steps", 0);
     if (const json* x = find(root, "solver")) read_solver(cx, *x, s.solver);

@@ -27,7 +27,7 @@ StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
         s.external(load);
         s.hold_constraints(load);
         try {
-            newton.solve(0.0, nullptr, nullptr, nullptr);
+            newton.solve(nullptr, nullptr);
         } catch (const StepFailure& failure) {
             s.copy_state(s.u, u_save);
             if (++halvings > 12)

@@ -19,6 +19,18 @@ struct StepFailure {
     index_t vertex;
 };
 
+// An integrator's history beyond u and v (Newmark's acceleration, BDF2's
+// previous step), saved and restored with u and v by step control. dt: the
+// step size it was made with; u_end, v_end: the state it belongs to (when
+// the application has written u or v since, it is stale).
+template <class S>
+struct History {
+    std::vector<BackendVector<double>> vectors;
+    BackendVector<S> u_end, v_end;
+    double dt = 0;
+    bool valid = false;
+};
+
 template <class S>
 struct SimState {
     Scene scene;
@@ -37,6 +49,7 @@ struct SimState {
     bool forces_current = false;  // f is at the step's starting u: the step skips its force pass
     BackendVector<double> h;      // external load (external())
     BackendVector<double> b, x;   // the linear solves' right-hand side and solution
+    History<S> history;           // the integrator's (integrators/time_integrator.hpp)
     StepStats stats;
     long step = 0;
     double time = 0;
@@ -65,6 +78,15 @@ struct SimState {
     void take_velocity(double T);
     // The constrained displacements at `fraction` of their targets.
     void hold_constraints(double fraction);
+
+    // dst = src (the vectors resized).
+    void copy_history(History<S>& dst, const History<S>& src) const;
+    // The history's k-th vector, 3 #V (zeros when new).
+    double* history_vector(std::size_t k);
+    // Whether the history belongs to the current u and v.
+    bool history_current() const;
+    // The history is complete for the current u and v after a step of dt.
+    void history_done(double dt);
 
     // f at u (timed as force_ms); W when `energy`.
     double forces(bool energy);
