@@ -269,6 +269,65 @@ edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integr
     });
 }
 
+namespace {
+// `count` values for a per-dof vector of the scene's mesh.
+void require_per_dof(const edgefem_scene* scene, size_t count, const char* name) {
+    const size_t nd = 3 * size_t(scene->scene.mesh.num_vertices());
+    if (count != nd) invalid(std::string(name) + ": expected 3 x #V = " + std::to_string(nd) + " values, got " + std::to_string(count));
+}
+std::vector<edgefem::Keyframe> keyframes(const double* times, const double* values, size_t count, const char* name) {
+    if (count > 0) {
+        require(times, "times");
+        require(values, "values");
+    }
+    std::vector<edgefem::Keyframe> k;
+    for (size_t i = 0; i < count; ++i) {
+        if (!std::isfinite(times[i]) || !std::isfinite(values[i]))
+            invalid(std::string(name) + "[" + std::to_string(i) + "] is not finite");
+        if (i > 0 && !(times[i] > times[i - 1]))
+            invalid(std::string(name) + "[" + std::to_string(i) + "]: times must increase strictly");
+        k.push_back({times[i], values[i]});
+    }
+    return k;
+}
+}  // namespace
+
+edgefem_status edgefem_scene_set_initial_state(edgefem_scene* scene, const double* displacement, const double* velocity,
+                                               size_t count) {
+    return guard("edgefem_scene_set_initial_state", [&] {
+        require(scene, "scene");
+        require_per_dof(scene, count, "count");
+        if (displacement) require_finite(displacement, count, "displacement");
+        if (velocity) require_finite(velocity, count, "velocity");
+        scene->scene.initial_displacement.assign(displacement, displacement ? displacement + count : displacement);
+        scene->scene.initial_velocity.assign(velocity, velocity ? velocity + count : velocity);
+    });
+}
+
+edgefem_status edgefem_scene_set_prescribed_keyframes(edgefem_scene* scene, const double* times, const double* values,
+                                                      size_t count) {
+    return guard("edgefem_scene_set_prescribed_keyframes", [&] {
+        require(scene, "scene");
+        scene->scene.prescribed_keyframes = keyframes(times, values, count, "prescribed.keyframes");
+    });
+}
+
+edgefem_status edgefem_scene_set_load(edgefem_scene* scene, const double* load, size_t count, const double* times,
+                                      const double* values, size_t key_count) {
+    return guard("edgefem_scene_set_load", [&] {
+        require(scene, "scene");
+        if (count > 0) {
+            require(load, "load");
+            require_per_dof(scene, count, "count");
+            require_finite(load, count, "load");
+        }
+        std::vector<edgefem::Keyframe> k = keyframes(times, values, key_count, "load.keyframes");
+        if (count == 0 && !k.empty()) invalid("load.keyframes: keyframes without a load");
+        scene->scene.load.assign(load, load ? load + count : load);
+        scene->scene.load_keyframes = std::move(k);
+    });
+}
+
 edgefem_status edgefem_scene_set_newmark(edgefem_scene* scene, double beta, double gamma) {
     return guard("edgefem_scene_set_newmark", [&] {
         require(scene, "scene");

@@ -52,6 +52,34 @@ bool is_explicit(Integrator i) { return i == Integrator::Explicit || i == Integr
 
 const char* to_string(LinearSolver s) { return s == LinearSolver::CG ? "cg" : "direct"; }
 
+double keyframe_value(const std::vector<Keyframe>& keys, double t) {
+    if (keys.empty()) return 1;
+    if (t <= keys.front().time) return keys.front().value;
+    for (std::size_t k = 1; k < keys.size(); ++k)
+        if (t <= keys[k].time) {
+            const Keyframe &a = keys[k - 1], &b = keys[k];
+            return a.value + (b.value - a.value) * (t - a.time) / (b.time - a.time);
+        }
+    return keys.back().value;
+}
+
+namespace {
+void check_keyframes(const std::string& field, const std::vector<Keyframe>& keys) {
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+        const std::string f = field + "[" + std::to_string(k) + "]";
+        if (!std::isfinite(keys[k].time) || !std::isfinite(keys[k].value)) bad(f, "non-finite time or value");
+        if (k > 0 && !(keys[k].time > keys[k - 1].time)) bad(f, "times must increase strictly");
+    }
+}
+void check_per_dof(const std::string& field, const std::vector<double>& x, std::size_t nd) {
+    if (x.empty()) return;
+    if (x.size() != nd)
+        bad(field, "expected 3 x #V = " + std::to_string(nd) + " values, got " + std::to_string(x.size()));
+    for (std::size_t i = 0; i < x.size(); ++i)
+        if (!std::isfinite(x[i])) bad(field, "non-finite value at vertex " + std::to_string(i / 3));
+}
+}  // namespace
+
 void Scene::validate() const {
     const index_t nv = mesh.num_vertices();
     if (mesh.num_tets() == 0) bad("mesh", "the mesh has no tets");
@@ -101,6 +129,13 @@ void Scene::validate() const {
     positive("dt", dt);
     if (steps < 0) bad("steps", "must be >= 0");
     if (prescribed_steps < 1) bad("prescribed.steps", "must be >= 1");
+    check_keyframes("prescribed.keyframes", prescribed_keyframes);
+    check_keyframes("load.keyframes", load_keyframes);
+    const std::size_t nd = 3 * std::size_t(nv);
+    check_per_dof("load", load, nd);
+    check_per_dof("initial.displacement", initial_displacement, nd);
+    check_per_dof("initial.velocity", initial_velocity, nd);
+    if (!load_keyframes.empty() && load.empty()) bad("load.keyframes", "keyframes without a load");
     positive("solver.cg_tolerance", solver.cg_tolerance);
     if (solver.cg_max_iterations < 1) bad("solver.cg_max_iterations", "must be >= 1");
     if (solver.cg_fixed_iterations < 0) bad("solver.cg_fixed_iterations", "must be >= 0");

@@ -12,7 +12,7 @@ namespace edgefem::sim {
 template <class S>
 EnergySample EnergyGuard<S>::sample(double W) const {
     const std::array<double, 3> s =
-        s_.kernels.energy_sums(s_.u.data(), s_.v.data(), s_.fext.data(), s_.mass.data(), s_.scene.gravity, s_.n());
+        s_.kernels.energy_sums(s_.u.data(), s_.v.data(), s_.fext_now(), s_.mass.data(), s_.scene.gravity, s_.n());
     return {s[0], W, s[1], s[2]};
 }
 

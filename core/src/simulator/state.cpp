@@ -52,6 +52,18 @@ SimState<S>::SimState(Scene s, std::shared_ptr<const Backend<S>> back)
     h = vector<double>(nd);
     x = vector<double>(nd);
     b = vector<double>(nd);
+    scene_load = vector<double>(scene.load.empty() ? 0 : nd);
+    if (!scene.load.empty()) {
+        scene_load.write(scene.load);
+        fext_step = vector<S>(nd);
+    }
+    const auto initial = [&](BackendVector<S>& dst, const std::vector<double>& src) {
+        if (src.empty()) return;
+        std::vector<S> tmp(src.begin(), src.end());
+        dst.write(tmp);
+    };
+    initial(u, scene.initial_displacement);
+    initial(v, scene.initial_velocity);
 }
 
 template <class S>
@@ -98,11 +110,21 @@ void SimState<S>::history_done(double dt) {
 
 template <class S>
 void SimState<S>::external(double load) {
-    kernels.external_load(h.data(), fext.data(), mass.data(), scene.gravity, load, n());
+    kernels.external_load(h.data(), fext_now(), mass.data(), scene.gravity, load, n());
+}
+
+template <class S>
+void SimState<S>::update_load(double t) {
+    if (!scene_load.size()) return;
+    b.resize(n());
+    kernels.from_state(b.data(), fext.data(), n());  // b: scratch until the step's solve writes it
+    kernels.line_search_point(fext_step.data(), b.data(), scene_load.data(), keyframe_value(scene.load_keyframes, t),
+                              n());
 }
 
 template <class S>
 double SimState<S>::ramp(double t) const {
+    if (!scene.prescribed_keyframes.empty()) return keyframe_value(scene.prescribed_keyframes, t);
     return std::max(ramp_floor, std::min(1.0, t / (scene.prescribed_steps * scene.dt) * (1 + 1e-12)));
 }
 

@@ -47,6 +47,8 @@ struct SimState {
     BackendVector<double> con_disp;         // their final displacement (3 each)
     double ramp_floor = 0;                  // 1 after solve_static: the prescribed targets are reached
     bool forces_current = false;  // f is at the step's starting u: the step skips its force pass
+    BackendVector<double> scene_load;  // scene.load (3 #V; empty: none)
+    BackendVector<S> fext_step;        // with a scene load: f_ext + its keyframed value over the step
     BackendVector<double> h;      // external load (external())
     BackendVector<double> b, x;   // the linear solves' right-hand side and solution
     History<S> history;           // the integrator's (integrators/time_integrator.hpp)
@@ -68,9 +70,14 @@ struct SimState {
     // dst = src (dst resized).
     void copy_state(BackendVector<S>& dst, const BackendVector<S>& src) const;
 
-    // External load h = load (M g + f_ext).
+    // External load h = load (M g + f_ext), f_ext the step's (fext_now()).
     void external(double load);
-    // Fraction of the prescribed targets reached at time t.
+    // The external force of a step from now: the application's f_ext plus
+    // the scene's load at time t (keyframed; the step's midpoint).
+    void update_load(double t);
+    const S* fext_now() const { return scene_load.size() ? fext_step.data() : fext.data(); }
+    // Fraction of the prescribed targets reached at time t (the keyframes,
+    // else the ramp over prescribed_steps).
     double ramp(double t) const;
     // Constrained velocities that reach the targets at time t_end.
     void constrained_velocities(double T, double t_end, double* vel) const;

@@ -17,6 +17,7 @@ void StepControl<S>::advance(double T, int depth) {
     }
     try {
         s_.forces_current = false;
+        s_.update_load(s_.time + T / 2);
         const bool guard = guard_.enabled();
         EnergySample start;
         bool moved = false;

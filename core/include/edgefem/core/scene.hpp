@@ -87,6 +87,13 @@ struct SolverSettings {
     double max_energy_growth = 10;
 };
 
+// A value given at times (s), linear in between, constant before the first
+// and after the last (keyframe_value).
+struct Keyframe {
+    double time, value;
+};
+double keyframe_value(const std::vector<Keyframe>& keys, double t);
+
 // A vertex driven to a target position.
 struct Prescribed {
     index_t vertex;
@@ -104,6 +111,17 @@ struct Scene {
     std::vector<index_t> fixed;              // held at their rest position
     std::vector<Prescribed> prescribed;      // moved linearly from rest to target
     int prescribed_steps = 1;                // dynamics: steps over which targets are reached
+    // Dynamics: the fraction of the prescribed displacements (target - rest)
+    // at time t, piecewise linear (keyframe_value); empty: the linear ramp
+    // over prescribed_steps.
+    std::vector<Keyframe> prescribed_keyframes;
+    // An external load (N per dof, 3 #V; empty: none) scaled at time t by
+    // load_keyframes (empty: 1); added to the application's
+    // Simulator::external_forces().
+    std::vector<double> load;
+    std::vector<Keyframe> load_keyframes;
+    // The initial state (3 #V each; empty: at rest).
+    std::vector<double> initial_displacement, initial_velocity;
     Integrator integrator = Integrator::SemiImplicit;
     IntegratorParameters integrator_parameters;
     double dt = 1e-3;                        // s
