@@ -72,8 +72,9 @@ EDGEFEM_HOST_DEVICE inline NewtonTerms newton_terms(bool dynamic, double f, doub
 
 // The second-order integrators' predictions (integrators/implicit_step.hpp):
 // c0 u + c1 v + c2 h1 + c3 h2 from the state and two history values.
-EDGEFEM_HOST_DEVICE inline double history_combination(const double* c, double u, double v, double h1, double h2) {
-    return c[0] * u + c[1] * v + c[2] * h1 + c[3] * h2;
+EDGEFEM_HOST_DEVICE inline double history_combination(double c0, double c1, double c2, double c3, double u, double v,
+                                                       double h1, double h2) {
+    return c0 * u + c1 * v + c2 * h1 + c3 * h2;
 }
 
 // The load of an implicit scheme at one dof: (c_h h + c_r r + c_a m a) /
