@@ -159,8 +159,8 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_integrator(edgefem_scene* scen
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_newmark(edgefem_scene* scene, double beta, double gamma);
 /** Generalized-alpha's spectral radius at infinite frequency rho_inf in [0, 1] (default 0.8). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_generalized_alpha(edgefem_scene* scene, double rho_inf);
-/** Initial displacement and velocity, 3 x #V values each (NULL: zero);
- *  `count` must be 3 x #V. */
+/** Initial displacement and velocity, 3 x (vertex count) values each (NULL: zero);
+ *  `count` must be 3 x (vertex count). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_initial_state(edgefem_scene* scene, const double* displacement,
                                                                 const double* velocity, size_t count);
 /** Prescribed motion as keyframes: at times[k] (s, increasing) the fraction
@@ -168,7 +168,7 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_initial_state(edgefem_scene* s
  *  linear ramp again). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_prescribed_keyframes(edgefem_scene* scene, const double* times,
                                                                        const double* values, size_t count);
-/** An external load (N per dof, 3 x #V values; count 0: none), scaled by
+/** An external load (N per dof, 3 x (vertex count) values; count 0: none), scaled by
  *  keyframes (times, values, key_count; 0 keys: constant). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_load(edgefem_scene* scene, const double* load, size_t count,
                                                        const double* times, const double* values, size_t key_count);
