@@ -187,6 +187,54 @@ TEST(SceneJson, RelativePathsResolveAgainstTheSceneFolder) {
     EXPECT_EQ(parse(R"({"mesh": ")" + dir.file("meshes/small0") + R"("})", "/nonexistent").scene.mesh.num_tets(), 3);
 }
 
+// The integrators' parameters, initial conditions, keyframed prescribed
+// motion and loads (docs/scenes.md).
+TEST(SceneJson, IntegratorsInitialStateAndKeyframes) {
+    TempDir dir("scene_keyframes");
+    spit(dir.file("v.txt"), "# index vx vy vz\n4 1 2 3\n");
+    spit(dir.file("u.txt"), "13 0.001 0 0\n");
+    spit(dir.file("f.txt"), "26 0 0 -2\n");
+    spit(dir.file("t.txt"), "26 0.01 0.01 0.02\n");
+    const Scene s = parse(scene(R"("integrator": "generalized-alpha", "generalized_alpha": {"rho_inf": 0.5},
+        "newmark": {"beta": 0.3, "gamma": 0.6}, "initial": {"displacement": {"file": "u.txt"}, "velocity": {"file": "v.txt"}},
+        "load": {"file": "f.txt", "keyframes": [[0, 0], [0.1, 1], [0.2, 0]]},
+        "prescribed": {"file": "t.txt", "keyframes": [[0, 0], [0.05, 1]]})"), dir.path()).scene;
+    EXPECT_EQ(s.integrator, Integrator::GeneralizedAlpha);
+    EXPECT_EQ(s.integrator_parameters.rho_inf, 0.5);
+    EXPECT_EQ(s.integrator_parameters.newmark_beta, 0.3);
+    EXPECT_EQ(s.integrator_parameters.newmark_gamma, 0.6);
+    ASSERT_EQ(s.initial_velocity.size(), 81u);
+    EXPECT_EQ(s.initial_velocity[12], 1);
+    EXPECT_EQ(s.initial_velocity[14], 3);
+    EXPECT_EQ(s.initial_velocity[15], 0);
+    EXPECT_EQ(s.initial_displacement[39], 0.001);
+    EXPECT_EQ(s.load[80], -2);
+    EXPECT_EQ(keyframe_value(s.load_keyframes, 0.05), 0.5);
+    EXPECT_EQ(keyframe_value(s.load_keyframes, 0.3), 0);
+    EXPECT_EQ(keyframe_value(s.prescribed_keyframes, 0.025), 0.5);
+    // A uniform velocity and a rigid rotation about a point (v = linear + w x (X - c)).
+    EXPECT_EQ(parse(scene(R"("initial": {"velocity": [0, 0, -1]})")).scene.initial_velocity[2], -1);
+    const Scene r = parse(scene(R"("initial": {"velocity": {"angular": [0, 0, 2], "center": [0.01, 0, 0]}})")).scene;
+    // vertex 0 at (-0.01, -0.01, -0.01): r = (-0.02, -0.01, -0.01), w x r = (0.02, -0.04, 0).
+    EXPECT_NEAR(r.initial_velocity[0], 0.02, 1e-15);
+    EXPECT_NEAR(r.initial_velocity[1], -0.04, 1e-15);
+    EXPECT_EQ(r.initial_velocity[2], 0);
+    // Bad values name the key.
+    expect_error(scene(R"("generalized_alpha": {"rho_inf": 1.5})"), {"\"generalized_alpha.rho_inf\"", "[0, 1]"});
+    expect_error(scene(R"("newmark": {"beta": 0.7})"), {"\"newmark.beta\""});
+    expect_error(scene(R"("newmark": {"gamma": 0.2})"), {"\"newmark.gamma\""});
+    expect_error(scene(R"("newmark": {"alpha": 0.2})"), {"\"newmark.alpha\"", "unknown key"});
+    expect_error(scene(R"("initial": {"velocity": [1, 2]})"), {"\"initial.velocity\""});
+    expect_error(scene(R"("initial": {"velocity": {"angular": [1, 2, "x"]}})"), {"\"initial.velocity.angular[2]\""});
+    expect_error(scene(R"("initial": {"velocity": {"file": "nope.txt"}})"), {"\"initial.velocity.file\""}, dir.path());
+    expect_error(scene(R"("load": {"keyframes": [[0, 1]]})"), {"\"load.file\"", "required"});
+    expect_error(scene(R"("load": {"file": "f.txt", "keyframes": [[0, 1], [0, 2]]})"),
+                 {"\"load.keyframes[1][0]\"", "increase"}, dir.path());
+    expect_error(scene(R"("load": {"file": "f.txt", "keyframes": [[0]]})"), {"\"load.keyframes[0]\""}, dir.path());
+    expect_error(scene(R"("prescribed": {"file": "t.txt", "keyframes": []})"), {"\"prescribed.keyframes\""}, dir.path());
+    expect_error(scene(R"("integrator": "bdf3")"), {"\"integrator\"", "\"bdf2\"", "\"verlet\""});
+}
+
 TEST(SceneJson, RegionMaterials) {
     // small1 has regions 1 and 2.
     const SceneFile sf = parse(R"({"mesh": ")" + data_file("small1") + R"(",

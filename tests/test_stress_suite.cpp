@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "lab/stress_suite.hpp"
 
@@ -24,8 +25,13 @@ std::vector<StressResult> run(const std::string& filter, double seconds = 1.0) {
 }  // namespace
 
 TEST(StressSuite, RandomInitialStateRecoversWithEveryIntegrator) {
-    const auto rs = run("random-state");
-    ASSERT_EQ(rs.size(), 3u);
+    std::vector<StressResult> rs;
+    for (const char* f : {"random-state explicit", "random-state semi-implicit", "random-state implicit",
+                          "random-state bdf2"}) {  // bdf2 and bdf2-linear
+        const auto part = run(f);
+        rs.insert(rs.end(), part.begin(), part.end());
+    }
+    ASSERT_EQ(rs.size(), 5u);
     for (const auto& r : rs) {
         SCOPED_TRACE(r.integrator + ": " + r.reason);
         EXPECT_EQ(r.verdict, StressVerdict::Pass);

@@ -25,6 +25,7 @@ struct SimulateOptions {
     std::string scene;  // empty: the built-in default
     std::string out;    // overrides output.dir
     int steps = -1;     // >= 0 overrides the scene's steps
+    std::string integrator;  // non-empty overrides the scene's integrator
     // Its ordering is the internal vertex numbering: RCM by default (the
     // force on bunny-1m runs 2-2.5x faster than in TetGen's numbering:
     // docs/layouts.md, "Orderings: bunny-1m force, 1 thread"); frames and
@@ -84,6 +85,11 @@ void run_simulate(const SimulateOptions& opts) {
     else
         sf.output.dir = opts.out;
     if (opts.steps >= 0) sf.scene.steps = opts.steps;
+    if (!opts.integrator.empty()) {
+        for (const auto& [name, value] : integrator_names())
+            if (opts.integrator == name) sf.scene.integrator = value;
+        sf.scene.validate();  // settings the new integrator does not take are errors
+    }
     const OutputSettings out = sf.output;
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
@@ -216,6 +222,10 @@ void add_simulate_command(CLI::App& app) {
         ->check(non_empty_path());
     cmd->add_option("--steps", opts->steps, "Number of steps (overrides the scene's steps)")
         ->check(int_in_range(0));
+    std::vector<std::string> integrators;
+    for (const auto& [name, value] : integrator_names()) integrators.push_back(name);
+    cmd->add_option("--integrator", opts->integrator, "Time integrator (overrides the scene's; docs/dynamics.md)")
+        ->check(CLI::IsMember(integrators));
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->run.ordering);
     add_run_options(*cmd, opts->run);

@@ -51,7 +51,7 @@ const char* to_string(StressExpectation e); // "pass", "fail", "either"
 struct StressResult {
     std::string group;        // dt, young, poisson, compress, invert, noise, sliver, twist
     std::string name;         // e.g. "dt=1/30", "young=1e9"
-    std::string integrator;   // explicit | semi-implicit | implicit
+    std::string integrator;   // to_string(Integrator): explicit, semi-implicit, implicit, newmark, ...
     double dt = 0;
     double seconds = 0;       // simulated time asked for
     double simulated = 0;     // simulated time reached

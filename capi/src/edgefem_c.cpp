@@ -263,12 +263,91 @@ edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt) {
 edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator) {
     return guard("edgefem_scene_set_integrator", [&] {
         require(scene, "scene");
-        switch (integrator) {
-            case EDGEFEM_EXPLICIT: scene->scene.integrator = edgefem::Integrator::Explicit; break;
-            case EDGEFEM_SEMI_IMPLICIT: scene->scene.integrator = edgefem::Integrator::SemiImplicit; break;
-            case EDGEFEM_IMPLICIT: scene->scene.integrator = edgefem::Integrator::Implicit; break;
-            default: invalid("unknown integrator " + std::to_string(int(integrator)));
+        // The C values are the enum's order (integrator_names()).
+        static_assert(int(edgefem::Integrator::Implicit) == EDGEFEM_IMPLICIT &&
+                      int(edgefem::Integrator::Verlet) == EDGEFEM_VERLET);
+        const auto& names = edgefem::integrator_names();
+        if (int(integrator) < 0 || std::size_t(integrator) >= names.size())
+            invalid("unknown integrator " + std::to_string(int(integrator)));
+        scene->scene.integrator = names[std::size_t(integrator)].second;
+    });
+}
+
+namespace {
+// `count` values for a per-dof vector of the scene's mesh.
+void require_per_dof(const edgefem_scene* scene, size_t count, const char* name) {
+    const size_t nd = 3 * size_t(scene->scene.mesh.num_vertices());
+    if (count != nd) invalid(std::string(name) + ": expected 3 x #V = " + std::to_string(nd) + " values, got " + std::to_string(count));
+}
+std::vector<edgefem::Keyframe> keyframes(const double* times, const double* values, size_t count, const char* name) {
+    if (count > 0) {
+        require(times, "times");
+        require(values, "values");
+    }
+    std::vector<edgefem::Keyframe> k;
+    for (size_t i = 0; i < count; ++i) {
+        if (!std::isfinite(times[i]) || !std::isfinite(values[i]))
+            invalid(std::string(name) + "[" + std::to_string(i) + "] is not finite");
+        if (i > 0 && !(times[i] > times[i - 1]))
+            invalid(std::string(name) + "[" + std::to_string(i) + "]: times must increase strictly");
+        k.push_back({times[i], values[i]});
+    }
+    return k;
+}
+}  // namespace
+
+edgefem_status edgefem_scene_set_initial_state(edgefem_scene* scene, const double* displacement, const double* velocity,
+                                               size_t count) {
+    return guard("edgefem_scene_set_initial_state", [&] {
+        require(scene, "scene");
+        require_per_dof(scene, count, "count");
+        if (displacement) require_finite(displacement, count, "displacement");
+        if (velocity) require_finite(velocity, count, "velocity");
+        scene->scene.initial_displacement.assign(displacement, displacement ? displacement + count : displacement);
+        scene->scene.initial_velocity.assign(velocity, velocity ? velocity + count : velocity);
+    });
+}
+
+edgefem_status edgefem_scene_set_prescribed_keyframes(edgefem_scene* scene, const double* times, const double* values,
+                                                      size_t count) {
+    return guard("edgefem_scene_set_prescribed_keyframes", [&] {
+        require(scene, "scene");
+        scene->scene.prescribed_keyframes = keyframes(times, values, count, "prescribed.keyframes");
+    });
+}
+
+edgefem_status edgefem_scene_set_load(edgefem_scene* scene, const double* load, size_t count, const double* times,
+                                      const double* values, size_t key_count) {
+    return guard("edgefem_scene_set_load", [&] {
+        require(scene, "scene");
+        if (count > 0) {
+            require(load, "load");
+            require_per_dof(scene, count, "count");
+            require_finite(load, count, "load");
         }
+        std::vector<edgefem::Keyframe> k = keyframes(times, values, key_count, "load.keyframes");
+        if (count == 0 && !k.empty()) invalid("load.keyframes: keyframes without a load");
+        scene->scene.load.assign(load, load ? load + count : load);
+        scene->scene.load_keyframes = std::move(k);
+    });
+}
+
+edgefem_status edgefem_scene_set_newmark(edgefem_scene* scene, double beta, double gamma) {
+    return guard("edgefem_scene_set_newmark", [&] {
+        require(scene, "scene");
+        if (!(beta > 0 && beta <= 0.5)) invalid("newmark.beta must lie in (0, 1/2], got " + std::to_string(beta));
+        if (!(gamma >= 0.5 && gamma <= 1)) invalid("newmark.gamma must lie in [1/2, 1], got " + std::to_string(gamma));
+        scene->scene.integrator_parameters.newmark_beta = beta;
+        scene->scene.integrator_parameters.newmark_gamma = gamma;
+    });
+}
+
+edgefem_status edgefem_scene_set_generalized_alpha(edgefem_scene* scene, double rho_inf) {
+    return guard("edgefem_scene_set_generalized_alpha", [&] {
+        require(scene, "scene");
+        if (!(rho_inf >= 0 && rho_inf <= 1))
+            invalid("generalized_alpha.rho_inf must lie in [0, 1], got " + std::to_string(rho_inf));
+        scene->scene.integrator_parameters.rho_inf = rho_inf;
     });
 }
 

@@ -22,14 +22,63 @@ void non_negative(const std::string& field, double v) {
 }  // namespace
 
 const char* to_string(Integrator i) {
-    switch (i) {
-        case Integrator::Explicit: return "explicit";
-        case Integrator::SemiImplicit: return "semi-implicit";
-        default: return "implicit";
-    }
+    for (const auto& [name, value] : integrator_names())
+        if (value == i) return name;
+    return "unknown";
 }
 
+const std::vector<std::pair<const char*, Integrator>>& integrator_names() {
+    static const std::vector<std::pair<const char*, Integrator>> names{
+        {"explicit", Integrator::Explicit},
+        {"semi-implicit", Integrator::SemiImplicit},
+        {"implicit", Integrator::Implicit},
+        {"newmark", Integrator::Newmark},
+        {"newmark-linear", Integrator::NewmarkLinear},
+        {"generalized-alpha", Integrator::GeneralizedAlpha},
+        {"generalized-alpha-linear", Integrator::GeneralizedAlphaLinear},
+        {"bdf2", Integrator::Bdf2},
+        {"bdf2-linear", Integrator::Bdf2Linear},
+        {"verlet", Integrator::Verlet},
+    };
+    return names;
+}
+
+bool is_linearised(Integrator i) {
+    return i == Integrator::SemiImplicit || i == Integrator::NewmarkLinear || i == Integrator::GeneralizedAlphaLinear ||
+           i == Integrator::Bdf2Linear;
+}
+
+bool is_explicit(Integrator i) { return i == Integrator::Explicit || i == Integrator::Verlet; }
+
 const char* to_string(LinearSolver s) { return s == LinearSolver::CG ? "cg" : "direct"; }
+
+double keyframe_value(const std::vector<Keyframe>& keys, double t) {
+    if (keys.empty()) return 1;
+    if (t <= keys.front().time) return keys.front().value;
+    for (std::size_t k = 1; k < keys.size(); ++k)
+        if (t <= keys[k].time) {
+            const Keyframe &a = keys[k - 1], &b = keys[k];
+            return a.value + (b.value - a.value) * (t - a.time) / (b.time - a.time);
+        }
+    return keys.back().value;
+}
+
+namespace {
+void check_keyframes(const std::string& field, const std::vector<Keyframe>& keys) {
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+        const std::string f = field + "[" + std::to_string(k) + "]";
+        if (!std::isfinite(keys[k].time) || !std::isfinite(keys[k].value)) bad(f, "non-finite time or value");
+        if (k > 0 && !(keys[k].time > keys[k - 1].time)) bad(f, "times must increase strictly");
+    }
+}
+void check_per_dof(const std::string& field, const std::vector<double>& x, std::size_t nd) {
+    if (x.empty()) return;
+    if (x.size() != nd)
+        bad(field, "expected 3 x #V = " + std::to_string(nd) + " values, got " + std::to_string(x.size()));
+    for (std::size_t i = 0; i < x.size(); ++i)
+        if (!std::isfinite(x[i])) bad(field, "non-finite value at vertex " + std::to_string(i / 3));
+}
+}  // namespace
 
 void Scene::validate() const {
     const index_t nv = mesh.num_vertices();
@@ -52,9 +101,18 @@ void Scene::validate() const {
     // Enums that came in as integers (bindings, casts) must name a value.
     if (model != ModelKind::FE && model != ModelKind::SN) bad("model", "not a model (fe or sn)");
     if (method != Method::Edge && method != Method::Tet) bad("method", "not a method (edge or tet)");
-    if (integrator != Integrator::Explicit && integrator != Integrator::SemiImplicit &&
-        integrator != Integrator::Implicit)
-        bad("integrator", "not an integrator (explicit, semi-implicit or implicit)");
+    if (std::string(to_string(integrator)) == "unknown") {
+        std::string list;
+        for (const auto& [name, value] : integrator_names()) list += (list.empty() ? "" : ", ") + std::string(name);
+        bad("integrator", "not an integrator (" + list + ")");
+    }
+    const IntegratorParameters& ip = integrator_parameters;
+    if (!(ip.newmark_beta > 0 && ip.newmark_beta <= 0.5))
+        bad("newmark.beta", "must lie in (0, 1/2], got " + std::to_string(ip.newmark_beta));
+    if (!(ip.newmark_gamma >= 0.5 && ip.newmark_gamma <= 1))
+        bad("newmark.gamma", "must lie in [1/2, 1], got " + std::to_string(ip.newmark_gamma));
+    if (!(ip.rho_inf >= 0 && ip.rho_inf <= 1))
+        bad("generalized_alpha.rho_inf", "must lie in [0, 1], got " + std::to_string(ip.rho_inf));
     if (solver.linear_solver != LinearSolver::CG && solver.linear_solver != LinearSolver::Direct)
         bad("solver.linear_solver", "not a linear solver (cg or direct)");
     materials.validate();
@@ -62,7 +120,7 @@ void Scene::validate() const {
         if (!std::isfinite(gravity[r])) bad("gravity", "non-finite component");
     non_negative("damping.alpha", rayleigh_alpha);
     non_negative("damping.beta", rayleigh_beta);
-    if (rayleigh_beta > 0 && integrator == Integrator::Explicit)
+    if (rayleigh_beta > 0 && is_explicit(integrator))
         bad("damping.beta", "stiffness-proportional damping needs an implicit integrator (explicit steps never build K)");
     if (model == ModelKind::SN && method == Method::Tet) bad("model", "the spring network exists only for the edge method");
     if (solver.definite_stiffness && method == Method::Tet)
@@ -70,6 +128,13 @@ void Scene::validate() const {
     positive("dt", dt);
     if (steps < 0) bad("steps", "must be >= 0");
     if (prescribed_steps < 1) bad("prescribed.steps", "must be >= 1");
+    check_keyframes("prescribed.keyframes", prescribed_keyframes);
+    check_keyframes("load.keyframes", load_keyframes);
+    const std::size_t nd = 3 * std::size_t(nv);
+    check_per_dof("load", load, nd);
+    check_per_dof("initial.displacement", initial_displacement, nd);
+    check_per_dof("initial.velocity", initial_velocity, nd);
+    if (!load_keyframes.empty() && load.empty()) bad("load.keyframes", "keyframes without a load");
     positive("solver.cg_tolerance", solver.cg_tolerance);
     if (solver.cg_max_iterations < 1) bad("solver.cg_max_iterations", "must be >= 1");
     if (solver.cg_fixed_iterations < 0) bad("solver.cg_fixed_iterations", "must be >= 0");
@@ -78,14 +143,16 @@ void Scene::validate() const {
     if (solver.load_steps < 1) bad("solver.load_steps", "must be >= 1");
     if (solver.max_step_halvings < 0) bad("solver.max_step_halvings", "must be >= 0");
     if (solver.stiffness_interval < 1) bad("solver.stiffness_interval", "must be >= 1");
-    // Settings that only the semi-implicit step with CG reads: elsewhere
-    // they were accepted and silently ignored.
+    // Settings that only the linearised steps with CG read: elsewhere they
+    // were accepted and silently ignored.
     const bool semi_cg = integrator == Integrator::SemiImplicit && solver.linear_solver == LinearSolver::CG;
+    const bool linear_cg = is_linearised(integrator) && solver.linear_solver == LinearSolver::CG;
     if (solver.stiffness_interval > 1 && !semi_cg)
         bad("solver.stiffness_interval", "> 1 applies only to the semi-implicit integrator with the cg solver");
-    if (solver.cg_fixed_iterations > 0 && !semi_cg)
+    if (solver.cg_fixed_iterations > 0 && !linear_cg)
         bad("solver.cg_fixed_iterations",
-            "> 0 applies only to the semi-implicit integrator with the cg solver (Newton's solves run to their tolerance)");
+            "> 0 applies only to the linearised integrators (semi-implicit, newmark-linear, generalized-alpha-linear, "
+            "bdf2-linear) with the cg solver (Newton's solves run to their tolerance)");
     if (!std::isfinite(solver.max_energy_growth) || (solver.max_energy_growth != 0 && !(solver.max_energy_growth >= 1)))
         bad("solver.max_energy_growth", "must be 0 (off) or a finite number >= 1, got " + std::to_string(solver.max_energy_growth));
     if (solver.fail_on_inverted && !count_inverted_tets)

@@ -159,7 +159,7 @@ std::string get_string(const Context& cx, const json& v, const std::string& path
 
 template <class E>
 E get_enum(const Context& cx, const json& v, const std::string& path,
-           std::initializer_list<std::pair<const char*, E>> names) {
+           const std::vector<std::pair<const char*, E>>& names) {
     if (v.is_string())
         for (const auto& [name, e] : names)
             if (v.get<std::string>() == name) return e;
@@ -398,9 +398,39 @@ void read_output(const Context& cx, const json& v, OutputSettings& o) {
     if (const json* x = find(v, "vtu")) o.vtu = get_bool(cx, *x, join(p, "vtu"));
 }
 
+// [[t, value], ...] with strictly increasing times.
+std::vector<Keyframe> read_keyframes(const Context& cx, const json& v, const std::string& path) {
+    if (!v.is_array() || v.empty()) cx.fail(path, "expected a non-empty array of [time, value] pairs, got " + show(v));
+    std::vector<Keyframe> keys;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+        const std::string key = item(path, k);
+        if (!v[k].is_array() || v[k].size() != 2) cx.fail(key, "expected [time, value], got " + show(v[k]));
+        keys.push_back({get_number(cx, v[k][0], item(key, 0)), get_number(cx, v[k][1], item(key, 1))});
+        if (k > 0 && !(keys[k].time > keys[k - 1].time)) cx.fail(item(key, 0), "times must increase strictly");
+    }
+    return keys;
+}
+
+// A file of `index x y z` lines: one vector per listed vertex (3 #V, zero
+// where not listed; a vertex listed twice is an error).
+std::vector<double> read_vertex_vectors(const Context& cx, const std::string& key, const std::string& file,
+                                        const Renumbering& renumber, const Mesh& mesh) {
+    std::vector<double> out(mesh.X.size(), 0.0);
+    std::map<index_t, std::int64_t> seen;
+    for (const IndexLine& l : read_index_file(cx, key, file, 3, renumber.read_count)) {
+        if (const auto [it, fresh] = seen.emplace(l.vertex, l.line); !fresh)
+            cx.fail(key, cx.resolve(file) + ":" + std::to_string(l.line) + ": vertex " + std::to_string(l.vertex) +
+                             " already listed on line " + std::to_string(it->second));
+        const index_t v = renumber(l.vertex);
+        if (v >= 0)
+            for (int r = 0; r < 3; ++r) out[3 * std::size_t(v) + r] = l.xyz[r];
+    }
+    return out;
+}
+
 void read_prescribed(const Context& cx, const json& v, const Renumbering& renumber, Scene& scene) {
     const std::string p = "prescribed";
-    check_keys(cx, v, p, {"file", "steps"});
+    check_keys(cx, v, p, {"file", "steps", "keyframes"});
     const json* f = find(v, "file");
     if (!f) cx.fail(join(p, "file"), "required key missing");
     const std::string key = join(p, "file");
@@ -413,13 +443,67 @@ void read_prescribed(const Context& cx, const json& v, const Renumbering& renumb
         if (renumber(l.vertex) >= 0) scene.prescribed.push_back({renumber(l.vertex), l.xyz});
     }
     if (const json* s = find(v, "steps")) scene.prescribed_steps = get_int(cx, *s, join(p, "steps"), 1);
+    if (const json* k = find(v, "keyframes")) scene.prescribed_keyframes = read_keyframes(cx, *k, join(p, "keyframes"));
+}
+
+// "load": {"file": PATH of `index fx fy fz` lines (N), "keyframes": [...]}.
+void read_load(const Context& cx, const json& v, const Renumbering& renumber, Scene& scene) {
+    check_keys(cx, v, "load", {"file", "keyframes"});
+    const json* f = find(v, "file");
+    if (!f) cx.fail("load.file", "required key missing");
+    scene.load = read_vertex_vectors(cx, "load.file", get_string(cx, *f, "load.file"), renumber, scene.mesh);
+    if (const json* k = find(v, "keyframes")) scene.load_keyframes = read_keyframes(cx, *k, "load.keyframes");
+}
+
+// "initial": {"displacement": {"file": PATH}, "velocity": [vx, vy, vz] |
+// {"file": PATH} | {"angular": [wx, wy, wz], "center": [x, y, z],
+// "linear": [vx, vy, vz]}} (a rigid motion: v = linear + w x (X - center)).
+void read_initial(const Context& cx, const json& v, const Renumbering& renumber, Scene& scene) {
+    check_keys(cx, v, "initial", {"displacement", "velocity"});
+    const Mesh& m = scene.mesh;
+    if (const json* d = find(v, "displacement")) {
+        check_keys(cx, *d, "initial.displacement", {"file"});
+        const json* f = find(*d, "file");
+        if (!f) cx.fail("initial.displacement.file", "required key missing");
+        scene.initial_displacement = read_vertex_vectors(cx, "initial.displacement.file",
+                                                         get_string(cx, *f, "initial.displacement.file"), renumber, m);
+    }
+    const json* w = find(v, "velocity");
+    if (!w) return;
+    const std::string p = "initial.velocity";
+    std::vector<double>& out = scene.initial_velocity;
+    if (w->is_array()) {
+        const std::array<double, 3> u = get_vec3(cx, *w, p);
+        out.resize(m.X.size());
+        for (std::size_t i = 0; i < out.size(); ++i) out[i] = u[i % 3];
+        return;
+    }
+    if (!w->is_object()) cx.fail(p, "expected [vx, vy, vz] or an object, got " + show(*w));
+    if (const json* f = find(*w, "file")) {
+        check_keys(cx, *w, p, {"file"});
+        out = read_vertex_vectors(cx, join(p, "file"), get_string(cx, *f, join(p, "file")), renumber, m);
+        return;
+    }
+    check_keys(cx, *w, p, {"angular", "center", "linear"});
+    std::array<double, 3> om{0, 0, 0}, c{0, 0, 0}, lin{0, 0, 0};
+    if (const json* x = find(*w, "angular")) om = get_vec3(cx, *x, join(p, "angular"));
+    if (const json* x = find(*w, "center")) c = get_vec3(cx, *x, join(p, "center"));
+    if (const json* x = find(*w, "linear")) lin = get_vec3(cx, *x, join(p, "linear"));
+    out.resize(m.X.size());
+    for (std::size_t a = 0; a < out.size() / 3; ++a) {
+        const double r[3] = {m.X[3 * a] - c[0], m.X[3 * a + 1] - c[1], m.X[3 * a + 2] - c[2]};
+        out[3 * a] = lin[0] + om[1] * r[2] - om[2] * r[1];
+        out[3 * a + 1] = lin[1] + om[2] * r[0] - om[0] * r[2];
+        out[3 * a + 2] = lin[2] + om[0] * r[1] - om[1] * r[0];
+    }
 }
 
 SceneFile parse(const Context& cx, const json& root) {
     if (!root.is_object()) throw InvalidArgument(cx.source + ": expected a JSON object at the top level, got " + show(root));
     check_keys(cx, root, "",
                {"mesh", "mesh_options", "material", "regions", "model", "method", "gravity", "damping", "fixed",
-                "prescribed", "integrator", "dt", "steps", "solver", "output"});
+                "prescribed", "load", "initial", "integrator", "newmark", "generalized_alpha", "dt", "steps", "solver",
+                "output"});
     SceneFile sf;
     Scene& s = sf.scene;
 
@@ -510,11 +594,21 @@ SceneFile parse(const Context& cx, const json& root) {
         s.fixed.erase(std::unique(s.fixed.begin(), s.fixed.end()), s.fixed.end());
     }
     if (const json* x = find(root, "prescribed")) read_prescribed(cx, *x, renumber, s);
+    if (const json* x = find(root, "load")) read_load(cx, *x, renumber, s);
+    if (const json* x = find(root, "initial")) read_initial(cx, *x, renumber, s);
     if (const json* x = find(root, "integrator"))
-        s.integrator = get_enum<Integrator>(cx, *x, "integrator",
-                                            {{"explicit", Integrator::Explicit},
-                                             {"semi-implicit", Integrator::SemiImplicit},
-                                             {"implicit", Integrator::Implicit}});
+        s.integrator = get_enum<Integrator>(cx, *x, "integrator", integrator_names());
+    if (const json* x = find(root, "newmark")) {
+        check_keys(cx, *x, "newmark", {"beta", "gamma"});
+        auto& ip = s.integrator_parameters;
+        if (const json* b = find(*x, "beta")) ip.newmark_beta = get_number(cx, *b, "newmark.beta", Range::Positive);
+        if (const json* g = find(*x, "gamma")) ip.newmark_gamma = get_number(cx, *g, "newmark.gamma", Range::Positive);
+    }
+    if (const json* x = find(root, "generalized_alpha")) {
+        check_keys(cx, *x, "generalized_alpha", {"rho_inf"});
+        if (const json* r = find(*x, "rho_inf"))
+            s.integrator_parameters.rho_inf = get_number(cx, *r, "generalized_alpha.rho_inf", Range::NonNegative);
+    }
     if (const json* x = find(root, "dt")) s.dt = get_number(cx, *x, "dt", Range::Positive);
     if (const json* x = find(root, "steps")) s.steps = get_int(cx, *x, "steps", 0);
     if (const json* x = find(root, "solver")) read_solver(cx, *x, s.solver);

@@ -14,6 +14,14 @@ Scene permute_scene(const Scene& scene, const std::vector<index_t>& new_of_old) 
     s.mesh = permute_mesh(scene.mesh, new_of_old);
     for (index_t& v : s.fixed) v = new_of_old.at(v);
     for (auto& p : s.prescribed) p.vertex = new_of_old.at(p.vertex);
+    // Per-vertex vectors (3 #V) follow their vertices.
+    for (std::vector<double>* x : {&s.load, &s.initial_displacement, &s.initial_velocity}) {
+        if (x->size() != 3 * new_of_old.size()) continue;  // empty (or wrong: validate() names it)
+        std::vector<double> out(x->size());
+        for (std::size_t v = 0; v < new_of_old.size(); ++v)
+            for (int r = 0; r < 3; ++r) out[3 * std::size_t(new_of_old[v]) + r] = (*x)[3 * v + r];
+        *x = std::move(out);
+    }
     return s;
 }
 

@@ -168,7 +168,23 @@ PYBIND11_MODULE(edgefem, m) {
     py::enum_<Integrator>(m, "Integrator")
         .value("Explicit", Integrator::Explicit)
         .value("SemiImplicit", Integrator::SemiImplicit)
-        .value("Implicit", Integrator::Implicit);
+        .value("Implicit", Integrator::Implicit)
+        .value("Newmark", Integrator::Newmark)
+        .value("NewmarkLinear", Integrator::NewmarkLinear)
+        .value("GeneralizedAlpha", Integrator::GeneralizedAlpha)
+        .value("GeneralizedAlphaLinear", Integrator::GeneralizedAlphaLinear)
+        .value("Bdf2", Integrator::Bdf2)
+        .value("Bdf2Linear", Integrator::Bdf2Linear)
+        .value("Verlet", Integrator::Verlet);
+    py::class_<Keyframe>(m, "Keyframe", "A value at a time (s): keyframes are linear in between.")
+        .def(py::init([](double t, double v) { return Keyframe{t, v}; }), py::arg("time"), py::arg("value"))
+        .def_readwrite("time", &Keyframe::time)
+        .def_readwrite("value", &Keyframe::value);
+    py::class_<IntegratorParameters>(m, "IntegratorParameters", "Newmark's beta and gamma, generalized-alpha's rho_inf.")
+        .def(py::init<>())
+        .def_readwrite("newmark_beta", &IntegratorParameters::newmark_beta)
+        .def_readwrite("newmark_gamma", &IntegratorParameters::newmark_gamma)
+        .def_readwrite("rho_inf", &IntegratorParameters::rho_inf);
     py::enum_<LinearSolver>(m, "LinearSolver").value("CG", LinearSolver::CG).value("Direct", LinearSolver::Direct);
 
     // ---- meshes ----
@@ -316,6 +332,12 @@ PYBIND11_MODULE(edgefem, m) {
             "List of (vertex, (x, y, z)) target positions.")
         .def_readwrite("prescribed_steps", &Scene::prescribed_steps)
         .def_readwrite("integrator", &Scene::integrator)
+        .def_readwrite("integrator_parameters", &Scene::integrator_parameters)
+        .def_readwrite("prescribed_keyframes", &Scene::prescribed_keyframes)
+        .def_readwrite("load", &Scene::load, "External load, 3 x #V values (N; empty: none).")
+        .def_readwrite("load_keyframes", &Scene::load_keyframes)
+        .def_readwrite("initial_displacement", &Scene::initial_displacement, "3 x #V values (empty: rest).")
+        .def_readwrite("initial_velocity", &Scene::initial_velocity, "3 x #V values (empty: rest).")
         .def_readwrite("dt", &Scene::dt)
         .def_readwrite("steps", &Scene::steps)
         .def_readwrite("solver", &Scene::solver)

@@ -200,6 +200,35 @@ def test_energy_guard_setting_and_stats():
         edgefem.Simulator(ok)
 
 
+def test_second_order_integrators_parameters_and_initial_state():
+    # Each new integrator runs; a free body given a uniform initial velocity
+    # translates rigidly; bad parameters name their key.
+    for integ in [edgefem.Integrator.Newmark, edgefem.Integrator.NewmarkLinear, edgefem.Integrator.GeneralizedAlpha,
+                  edgefem.Integrator.GeneralizedAlphaLinear, edgefem.Integrator.Bdf2, edgefem.Integrator.Bdf2Linear,
+                  edgefem.Integrator.Verlet]:
+        scene = clamped_box_scene(4, 1, 1)
+        scene.integrator = integ
+        scene.fixed = []
+        scene.gravity = (0.0, 0.0, 0.0)
+        n = 3 * scene.mesh.num_vertices
+        scene.initial_velocity = [0.1 if i % 3 == 0 else 0.0 for i in range(n)]
+        sim = edgefem.Simulator(scene)
+        sim.run(10)
+        u = np.asarray(sim.displacement).reshape(-1, 3)
+        assert np.allclose(u[:, 0], 10 * scene.dt * 0.1, atol=1e-12) and np.allclose(u[:, 1:], 0, atol=1e-12)
+    scene = clamped_box_scene(4, 1, 1)
+    scene.integrator = edgefem.Integrator.GeneralizedAlpha
+    params = scene.integrator_parameters
+    params.rho_inf = 1.5
+    scene.integrator_parameters = params
+    with pytest.raises(edgefem.InvalidArgument, match="generalized_alpha.rho_inf"):
+        edgefem.Simulator(scene)
+    scene = clamped_box_scene(4, 1, 1)
+    scene.prescribed_keyframes = [edgefem.Keyframe(0.0, 0.0), edgefem.Keyframe(0.0, 1.0)]
+    with pytest.raises(edgefem.InvalidArgument, match="prescribed.keyframes"):
+        edgefem.Simulator(scene)
+
+
 def test_vtu_series(tmp_path):
     mesh = small_box()
     u = edgefem.deformation(mesh, "twist", 0.1)

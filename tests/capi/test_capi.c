@@ -272,6 +272,20 @@ int main(void) {
                  "missing scene file");
     expect_error(edgefem_scene_set_integrator(scene, (edgefem_integrator)42), EDGEFEM_ERROR_INVALID_ARGUMENT,
                  "integrator", "unknown integrator");
+    expect_error(edgefem_scene_set_newmark(scene, 0.7, 0.5), EDGEFEM_ERROR_INVALID_ARGUMENT, "newmark.beta",
+                 "Newmark beta above 1/2");
+    expect_error(edgefem_scene_set_generalized_alpha(scene, -0.1), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                 "generalized_alpha.rho_inf", "negative rho_inf");
+    {
+        const double times[2] = {0.0, 0.0}, values[2] = {0.0, 1.0};
+        expect_error(edgefem_scene_set_prescribed_keyframes(scene, times, values, 2), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                     "increase", "keyframe times not increasing");
+        expect_error(edgefem_scene_set_initial_state(scene, times, NULL, 2), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                     "3 x #V", "initial state of the wrong length");
+    }
+    CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_BDF2_LINEAR));
+    CHECK_OK(edgefem_scene_set_generalized_alpha(scene, 0.5));
+    CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_SEMI_IMPLICIT));
     /* One vector: the message names the component, not a "vertex". */
     expect_error(edgefem_scene_set_gravity(scene, 0, NAN, 0), EDGEFEM_ERROR_INVALID_ARGUMENT, "gravity[1] is not finite",
                  "NaN gravity");

@@ -66,7 +66,14 @@ typedef enum edgefem_status {
 typedef enum edgefem_integrator {
     EDGEFEM_EXPLICIT = 0,      /**< symplectic Euler */
     EDGEFEM_SEMI_IMPLICIT = 1, /**< linearised backward Euler, one CG solve per step */
-    EDGEFEM_IMPLICIT = 2       /**< backward Euler by Newton */
+    EDGEFEM_IMPLICIT = 2,      /**< backward Euler by Newton */
+    EDGEFEM_NEWMARK = 3,                  /**< Newmark-beta (trapezoidal by default) by Newton */
+    EDGEFEM_NEWMARK_LINEAR = 4,           /**< Newmark-beta, linearised (one K per step) */
+    EDGEFEM_GENERALIZED_ALPHA = 5,        /**< generalized-alpha (rho_inf) by Newton */
+    EDGEFEM_GENERALIZED_ALPHA_LINEAR = 6, /**< generalized-alpha, linearised */
+    EDGEFEM_BDF2 = 7,                     /**< BDF2 by Newton */
+    EDGEFEM_BDF2_LINEAR = 8,              /**< BDF2, linearised */
+    EDGEFEM_VERLET = 9                    /**< velocity Verlet (explicit central differences) */
 } edgefem_integrator;
 
 /** Elastic models. */
@@ -148,6 +155,23 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_gravity(edgefem_scene* scene, 
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt);
 /** Integrator. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator);
+/** Newmark's beta in (0, 1/2] and gamma in [1/2, 1] (defaults 1/4, 1/2). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_newmark(edgefem_scene* scene, double beta, double gamma);
+/** Generalized-alpha's spectral radius at infinite frequency rho_inf in [0, 1] (default 0.8). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_generalized_alpha(edgefem_scene* scene, double rho_inf);
+/** Initial displacement and velocity, 3 x (vertex count) values each (NULL: zero);
+ *  `count` must be 3 x (vertex count). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_initial_state(edgefem_scene* scene, const double* displacement,
+                                                                const double* velocity, size_t count);
+/** Prescribed motion as keyframes: at times[k] (s, increasing) the fraction
+ *  values[k] of the targets is reached, linear in between (count 0: the
+ *  linear ramp again). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_prescribed_keyframes(edgefem_scene* scene, const double* times,
+                                                                       const double* values, size_t count);
+/** An external load (N per dof, 3 x (vertex count) values; count 0: none), scaled by
+ *  keyframes (times, values, key_count; 0 keys: constant). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_load(edgefem_scene* scene, const double* load, size_t count,
+                                                       const double* times, const double* values, size_t key_count);
 /** Elastic model (FE or SN). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_model(edgefem_scene* scene, edgefem_model model);
 /** Rayleigh damping D = alpha M + beta K. */

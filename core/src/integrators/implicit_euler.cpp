@@ -29,7 +29,8 @@ public:
         const double s = s_.ramp(s_.time + T);
         s_.kernels.to_state(s_.u.data(), upred.data(), n);
         s_.hold_constraints(s);
-        newton_.solve(T, u0.data(), upred.data(), op_damp_.get());
+        const Inertia inertia{1 / (T * T), 1 / T, u0.data(), upred.data()};
+        newton_.solve(&inertia, op_damp_.get());
         s_.kernels.implicit_velocity(s_.v.data(), s_.u.data(), u0.data(), T, n);
         return newton_.energy();  // Newton's last evaluation was at the new u
     }

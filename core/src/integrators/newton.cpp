@@ -10,16 +10,19 @@
 namespace edgefem::sim {
 
 template <class S>
-void Newton<S>::solve(double T, const double* u0, const double* upred, const ElasticOperator<S>* K0) {
+void Newton<S>::solve(const Inertia* scheme, const ElasticOperator<S>* K0) {
     const Scene& scene = s_.scene;
     const VectorKernels<S>& k = s_.kernels;
     const std::size_t n = s_.n();
     StepStats& stats = s_.stats;
     S* const u = s_.u.data();
     double* const x = s_.x.data();
-    const bool dynamic = T > 0;
-    const double c_m = dynamic ? 1 / (T * T) + scene.rayleigh_alpha / T : 0.0;
-    const double c_b = dynamic ? scene.rayleigh_beta / T : 0.0;
+    const bool dynamic = scheme != nullptr;
+    const double c_i = dynamic ? scheme->c_i : 0.0, c_d = dynamic ? scheme->c_d : 0.0;
+    const double* const u0 = dynamic ? scheme->ud : nullptr;
+    const double* const upred = dynamic ? scheme->upred : nullptr;
+    const double c_m = c_i + scene.rayleigh_alpha * c_d;
+    const double c_b = scene.rayleigh_beta * c_d;
     const auto& sv = scene.solver;
     BackendVector<double> R = s_.template vector<double>(n), du = s_.template vector<double>(n),
                           trial = s_.template vector<double>(n), K0d = s_.template vector<double>(n),
@@ -39,7 +42,7 @@ void Newton<S>::solve(double T, const double* u0, const double* upred, const Ela
         // terms and their sizes.
         const std::array<double, 4> sums =
             k.newton_residual({R.data(), inertia.data(), s_.f.data(), u, s_.h.data(), s_.mass.data(), upred,
-                               d_.data(), K0d.data(), s_.free_dof.data(), dynamic, T, scene.rayleigh_alpha, c_b},
+                               d_.data(), K0d.data(), s_.free_dof.data(), dynamic, c_i, c_d, scene.rayleigh_alpha, c_b},
                               n);
         phi += sums[2] - sums[0];
         mag += sums[1] + sums[3];

@@ -1,6 +1,7 @@
 // Newton with a backtracking line search on an incremental potential:
-// dynamic (T > 0) phi(u) = W(u) - h.u + |u - upred|_M^2 / (2 T^2) + the
-// damping terms, static (T = 0) phi(u) = W(u) - h.u. Shared by the implicit
+// dynamic phi(u) = W(u) - h.u + c_i |u - upred|_M^2 / 2 + c_d (alpha
+// |u - ud|_M^2 + beta |u - ud|_K0^2) / 2 (backward Euler: c_i = 1 / T^2,
+// c_d = 1 / T, ud = u0), static phi(u) = W(u) - h.u. Shared by the implicit
 // step and the static solve. In: the state's u (constrained dofs at their
 // values) and h. Out: u at the minimum, f and W there; StepFailure when it
 // cannot converge.
@@ -10,22 +11,29 @@
 
 namespace edgefem::sim {
 
+// The dynamic terms of the potential: the scheme's coefficients and
+// predictions (3 #V each in the back-end's memory).
+struct Inertia {
+    double c_i, c_d;
+    const double* ud;
+    const double* upred;
+};
+
 template <class S>
 class Newton {
 public:
     Newton(SimState<S>& state, TangentSolve<S>& solve) : s_(state), solve_(solve), d_(state.template vector<double>(0)) {}
 
-    // u0: u at the step's start, upred = u0 + T v (3 #V in the back-end's
-    // memory; null when static). K0: the damping tangent when
+    // `scheme`: null when static. K0: the damping tangent when
     // scene.rayleigh_beta > 0, else null.
-    void solve(double T, const double* u0, const double* upred, const ElasticOperator<S>* K0);
+    void solve(const Inertia* scheme, const ElasticOperator<S>* K0);
     // The elastic energy at its last evaluation (the final u).
     double energy() const { return W_; }
 
 private:
     SimState<S>& s_;
     TangentSolve<S>& solve_;
-    BackendVector<double> d_;  // u - u0 in the residual
+    BackendVector<double> d_;  // u - ud in the residual
     double W_ = 0;
 };
 

@@ -2,10 +2,8 @@
 // steps): (c_m M + c_k K) v' = M v + T (h - f(u)) with c_m = 1 + T alpha,
 // c_k = T beta + T^2, then u' = u + T v'; the constrained dofs move to
 // their targets.
-#include <string>
-
+#include "integrators/implicit_step.hpp"
 #include "integrators/time_integrator.hpp"
-#include "simulator/messages.hpp"
 
 namespace edgefem::sim {
 
@@ -32,17 +30,7 @@ public:
                                           scene.solver.definite_stiffness, reuse, scene.solver.cg_fixed_iterations);
         stiffness_age_ = reuse ? stiffness_age_ + 1 : 1;
         stiffness_dt_ = T;
-        s_.stats.residual = res.residual;
-        if (!std::isfinite(res.residual))
-            throw StepFailure{"step " + std::to_string(s_.step + 1) + ": linear solve failed (non-finite residual)", -1};
-        if (!res.converged && scene.solver.cg_fixed_iterations == 0 && scene.solver.linear_solver == LinearSolver::CG) {
-            ++s_.stats.unconverged_solves;
-            if (scene.solver.fail_on_unconverged)
-                throw StepFailure{"step " + std::to_string(s_.step + 1) + ": CG stopped at " +
-                                      std::to_string(res.iterations) + " iterations with relative residual " +
-                                      sci(res.residual) + " above the tolerance " + sci(scene.solver.cg_tolerance),
-                                  -1};
-        }
+        check_linear_solve(s_, res);
         s_.take_velocity(T);
         return std::nullopt;
     }

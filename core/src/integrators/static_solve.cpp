@@ -13,6 +13,7 @@ StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
         throw InvalidArgument("static equilibrium needs fixed or prescribed vertices (else it is singular)");
     s.stats = StepStats{};
     StaticResult result;
+    s.update_load(s.time);
     Newton<S> newton(s, solve);
     // The increment halves on a failure, at most 12 times over the whole
     // solve. (A budget of 12 per load step, with increments that never
@@ -27,7 +28,7 @@ StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
         s.external(load);
         s.hold_constraints(load);
         try {
-            newton.solve(0.0, nullptr, nullptr, nullptr);
+            newton.solve(nullptr, nullptr);
         } catch (const StepFailure& failure) {
             s.copy_state(s.u, u_save);
             if (++halvings > 12)

@@ -35,5 +35,22 @@ template <class S>
 std::unique_ptr<TimeIntegrator<S>> make_semi_implicit_euler(SimState<S>& state, TangentSolve<S>& solve);
 template <class S>
 std::unique_ptr<TimeIntegrator<S>> make_implicit_euler(SimState<S>& state, TangentSolve<S>& solve);
+// The second-order ones; `linear`: the linearised form (implicit_step.hpp).
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_newmark(SimState<S>& state, TangentSolve<S>& solve, bool linear);
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_generalized_alpha(SimState<S>& state, TangentSolve<S>& solve, bool linear);
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_bdf2(SimState<S>& state, TangentSolve<S>& solve, bool linear);
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_velocity_verlet(SimState<S>& state);
+
+// Newmark's and generalized-alpha's coefficients (newmark.cpp).
+struct NewmarkCoefficients {
+    double beta, gamma, alpha_m, alpha_f;
+};
+template <class S>
+std::unique_ptr<TimeIntegrator<S>> make_newmark_family(SimState<S>& state, TangentSolve<S>& solve,
+                                                       NewmarkCoefficients c, bool linear);
 
 }  // namespace edgefem::sim

@@ -39,6 +39,10 @@ public:
     // displaced): the constraint's work is unknown, so the guard skips it.
     bool constraints_move(double t_end) const;
 
+    // After a failed step: its force passes (Newton's iterates) have
+    // overwritten f, so the next start evaluates the forces again.
+    void forget() { evaluated_valid_ = false; }
+
     // After a step of size T that started at `start` and ends with elastic
     // energy W_end.
     void check(double T, const EnergySample& start, double W_end, bool constraints_moved);

@@ -52,6 +52,18 @@ SimState<S>::SimState(Scene s, std::shared_ptr<const Backend<S>> back)
     h = vector<double>(nd);
     x = vector<double>(nd);
     b = vector<double>(nd);
+    scene_load = vector<double>(scene.load.empty() ? 0 : nd);
+    if (!scene.load.empty()) {
+        scene_load.write(scene.load);
+        fext_step = vector<S>(nd);
+    }
+    const auto initial = [&](BackendVector<S>& dst, const std::vector<double>& src) {
+        if (src.empty()) return;
+        std::vector<S> tmp(src.begin(), src.end());
+        dst.write(tmp);
+    };
+    initial(u, scene.initial_displacement);
+    initial(v, scene.initial_velocity);
 }
 
 template <class S>
@@ -61,12 +73,58 @@ void SimState<S>::copy_state(BackendVector<S>& dst, const BackendVector<S>& src)
 }
 
 template <class S>
+void SimState<S>::copy_history(History<S>& dst, const History<S>& src) const {
+    dst.vectors.resize(src.vectors.size());
+    for (std::size_t k = 0; k < src.vectors.size(); ++k) {
+        if (dst.vectors[k].size() != src.vectors[k].size()) dst.vectors[k] = vector<double>(src.vectors[k].size());
+        kernels.copy(dst.vectors[k].data(), src.vectors[k].data(), src.vectors[k].size());
+    }
+    if (dst.u_end.size() != src.u_end.size()) dst.u_end = vector<S>(0);
+    if (dst.v_end.size() != src.v_end.size()) dst.v_end = vector<S>(0);
+    copy_state(dst.u_end, src.u_end);
+    copy_state(dst.v_end, src.v_end);
+    dst.dt = src.dt;
+    dst.valid = src.valid;
+}
+
+template <class S>
+double* SimState<S>::history_vector(std::size_t k) {
+    while (history.vectors.size() <= k) history.vectors.push_back(vector<double>(n()));
+    return history.vectors[k].data();
+}
+
+template <class S>
+bool SimState<S>::history_current() const {
+    return history.valid && kernels.count_differences(u.data(), history.u_end.data(), n()) == 0 &&
+           kernels.count_differences(v.data(), history.v_end.data(), n()) == 0;
+}
+
+template <class S>
+void SimState<S>::history_done(double dt) {
+    if (history.u_end.size() != n()) history.u_end = vector<S>(0), history.v_end = vector<S>(0);
+    copy_state(history.u_end, u);
+    copy_state(history.v_end, v);
+    history.dt = dt;
+    history.valid = true;
+}
+
+template <class S>
 void SimState<S>::external(double load) {
-    kernels.external_load(h.data(), fext.data(), mass.data(), scene.gravity, load, n());
+    kernels.external_load(h.data(), fext_now(), mass.data(), scene.gravity, load, n());
+}
+
+template <class S>
+void SimState<S>::update_load(double t) {
+    if (!scene_load.size()) return;
+    b.resize(n());
+    kernels.from_state(b.data(), fext.data(), n());  // b: scratch until the step's solve writes it
+    kernels.line_search_point(fext_step.data(), b.data(), scene_load.data(), keyframe_value(scene.load_keyframes, t),
+                              n());
 }
 
 template <class S>
 double SimState<S>::ramp(double t) const {
+    if (!scene.prescribed_keyframes.empty()) return keyframe_value(scene.prescribed_keyframes, t);
     return std::max(ramp_floor, std::min(1.0, t / (scene.prescribed_steps * scene.dt) * (1 + 1e-12)));
 }
 

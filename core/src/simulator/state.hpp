@@ -19,6 +19,18 @@ struct StepFailure {
     index_t vertex;
 };
 
+// An integrator's history beyond u and v (Newmark's acceleration, BDF2's
+// previous step), saved and restored with u and v by step control. dt: the
+// step size it was made with; u_end, v_end: the state it belongs to (when
+// the application has written u or v since, it is stale).
+template <class S>
+struct History {
+    std::vector<BackendVector<double>> vectors;
+    BackendVector<S> u_end, v_end;
+    double dt = 0;
+    bool valid = false;
+};
+
 template <class S>
 struct SimState {
     Scene scene;
@@ -35,8 +47,11 @@ struct SimState {
     BackendVector<double> con_disp;         // their final displacement (3 each)
     double ramp_floor = 0;                  // 1 after solve_static: the prescribed targets are reached
     bool forces_current = false;  // f is at the step's starting u: the step skips its force pass
+    BackendVector<double> scene_load;  // scene.load (3 #V; empty: none)
+    BackendVector<S> fext_step;        // with a scene load: f_ext + its keyframed value over the step
     BackendVector<double> h;      // external load (external())
     BackendVector<double> b, x;   // the linear solves' right-hand side and solution
+    History<S> history;           // the integrator's (integrators/time_integrator.hpp)
     StepStats stats;
     long step = 0;
     double time = 0;
@@ -55,9 +70,14 @@ struct SimState {
     // dst = src (dst resized).
     void copy_state(BackendVector<S>& dst, const BackendVector<S>& src) const;
 
-    // External load h = load (M g + f_ext).
+    // External load h = load (M g + f_ext), f_ext the step's (fext_now()).
     void external(double load);
-    // Fraction of the prescribed targets reached at time t.
+    // The external force of a step from now: the application's f_ext plus
+    // the scene's load at time t (keyframed; the step's midpoint).
+    void update_load(double t);
+    const S* fext_now() const { return scene_load.size() ? fext_step.data() : fext.data(); }
+    // Fraction of the prescribed targets reached at time t (the keyframes,
+    // else the ramp over prescribed_steps).
     double ramp(double t) const;
     // Constrained velocities that reach the targets at time t_end.
     void constrained_velocities(double T, double t_end, double* vel) const;
@@ -65,6 +85,15 @@ struct SimState {
     void take_velocity(double T);
     // The constrained displacements at `fraction` of their targets.
     void hold_constraints(double fraction);
+
+    // dst = src (the vectors resized).
+    void copy_history(History<S>& dst, const History<S>& src) const;
+    // The history's k-th vector, 3 #V (zeros when new).
+    double* history_vector(std::size_t k);
+    // Whether the history belongs to the current u and v.
+    bool history_current() const;
+    // The history is complete for the current u and v after a step of dt.
+    void history_done(double dt);
 
     // f at u (timed as force_ms); W when `energy`.
     double forces(bool energy);

@@ -11,12 +11,15 @@ void StepControl<S>::advance(double T, int depth) {
     const bool may_retry = depth < s_.scene.solver.max_step_halvings;
     // Depth 0 restores the step's start, which step() has just saved.
     BackendVector<S> u_save = s_.template vector<S>(0), v_save = s_.template vector<S>(0);
+    History<S> history_save;
     if (may_retry && depth > 0) {
         s_.copy_state(u_save, s_.u);
         s_.copy_state(v_save, s_.v);
+        s_.copy_history(history_save, s_.history);
     }
     try {
         s_.forces_current = false;
+        s_.update_load(s_.time + T / 2);
         const bool guard = guard_.enabled();
         EnergySample start;
         bool moved = false;
@@ -32,9 +35,11 @@ void StepControl<S>::advance(double T, int depth) {
         s_.time += T;
     } catch (const StepFailure& failure) {
         s_.forces_current = false;
+        guard_.forget();
         if (!may_retry) throw;
         s_.copy_state(s_.u, depth == 0 ? step_start_u_ : u_save);
         s_.copy_state(s_.v, depth == 0 ? step_start_v_ : v_save);
+        s_.copy_history(s_.history, depth == 0 ? step_start_history_ : history_save);
         ++s_.stats.halvings;
         advance(T / 2, depth + 1);
         advance(T / 2, depth + 1);
@@ -51,12 +56,14 @@ const StepStats& StepControl<S>::step() {
     // Persistent buffers: one copy per step, no allocation.
     s_.copy_state(step_start_u_, s_.u);
     s_.copy_state(step_start_v_, s_.v);
+    s_.copy_history(step_start_history_, s_.history);
     try {
         advance(s_.scene.dt, 0);
     } catch (const StepFailure& failure) {
         s_.time = t_start;
         s_.copy_state(s_.u, step_start_u_);
         s_.copy_state(s_.v, step_start_v_);
+        s_.copy_history(s_.history, step_start_history_);
         s_.forces_current = false;
         throw SimulationError(failure.message, s_.step + 1, failure.vertex);
     }

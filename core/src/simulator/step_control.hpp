@@ -1,7 +1,8 @@
 // One step of scene.dt: the integrator's step with the energy guard and the
 // finiteness check after it, retried as two halves on a failure (up to
-// SolverSettings::max_step_halvings deep); a step that still fails restores
-// the state it started from and throws SimulationError.
+// SolverSettings::max_step_halvings deep; the integrator's history is
+// restored with u and v); a step that still fails restores the state it
+// started from and throws SimulationError.
 #pragma once
 
 #include "integrators/time_integrator.hpp"
@@ -24,6 +25,7 @@ private:
     TimeIntegrator<S>& integrator_;
     EnergyGuard<S> guard_;
     BackendVector<S> step_start_u_, step_start_v_;  // the state before the step (restored when it fails)
+    History<S> step_start_history_;                 // and the integrator's history
 };
 
 extern template class StepControl<double>;

@@ -102,6 +102,43 @@ public:
         launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { u[i] = S(ops::axpy(u_start[i], step, du[i])); });
     }
 
+    void history_predict(double* upred, double* ud, const S* u, const S* v, const double* h1, const double* h2,
+                         const std::array<double, 4>& cp, const std::array<double, 4>& cd,
+                         std::size_t n) const override {
+        const double p0 = cp[0], p1 = cp[1], p2 = cp[2], p3 = cp[3], q0 = cd[0], q1 = cd[1], q2 = cd[2], q3 = cd[3];
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
+            const double x = double(u[i]), y = double(v[i]), a = h1 ? h1[i] : 0.0, b = h2 ? h2[i] : 0.0;
+            upred[i] = ops::history_combination(p0, p1, p2, p3, x, y, a, b);
+            ud[i] = ops::history_combination(q0, q1, q2, q3, x, y, a, b);
+        });
+    }
+    void history_update(S* v, double* a, const S* u, const double* upred, const double* ud, const double* cvel,
+                        const std::uint8_t* free_dof, double c_v, double c_a, std::size_t n) const override {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
+            const double x = double(u[i]);
+            v[i] = S(free_dof[i] ? c_v * (x - ud[i]) : cvel[i]);
+            if (a) a[i] = free_dof[i] ? c_a * (x - upred[i]) : 0.0;
+        });
+    }
+    void dynamic_load(const DynamicLoadArgs<S>& args, std::size_t n) const override {
+        const DynamicLoadArgs<S> a = args;
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
+            a.out[i] = a.free_dof[i] ? ops::dynamic_load(a.h[i], double(a.f[i]), double(a.v[i]),
+                                                         a.c_a != 0 ? a.a[i] : 0.0, a.beta != 0 ? a.K0v[i] : 0.0,
+                                                         a.mass[i / 3], a.alpha, a.beta, a.c_h, a.c_r, a.c_a,
+                                                         a.per_mass)
+                                     : 0.0;
+        });
+    }
+    void verlet_kick(double* x, const S* v, const double* h, const S* f, const double* mass,
+                     const std::uint8_t* free_dof, double t, double alpha_e, double alpha_i,
+                     std::size_t n) const override {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
+            x[i] = free_dof[i] ? ops::verlet_kick(double(v[i]), t, h[i], double(f[i]), mass[i / 3], alpha_e, alpha_i)
+                               : double(v[i]);
+        });
+    }
+
     void constrained_velocities(double* vel, const S* u, const ConstraintView& c, double fraction,
                                 double T) const override {
         const index_t* vertex = c.vertex;
@@ -188,7 +225,7 @@ public:
                     const double u = double(a.u[i]);
                     const ops::NewtonTerms t = ops::newton_terms(
                         a.dynamic, double(a.f[i]), a.h[i], u, a.mass[i / 3], a.dynamic ? a.upred[i] : 0.0,
-                        a.dynamic ? a.d[i] : 0.0, a.dynamic ? a.K0d[i] : 0.0, a.T, a.alpha, a.c_b);
+                        a.dynamic ? a.d[i] : 0.0, a.dynamic ? a.K0d[i] : 0.0, a.c_i, a.c_d, a.alpha, a.c_b);
                     acc[0] += a.h[i] * u;
                     acc[1] += std::abs(a.h[i] * u);
                     a.inertia[i] = t.inertia;

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "edgefem/core/edge_model.hpp"
@@ -18,7 +19,32 @@ namespace edgefem {
 enum class Integrator {
     Explicit,      // symplectic Euler: never builds K
     SemiImplicit,  // linearised backward Euler, one K per step, CG (the talk's form)
-    Implicit,      // backward Euler solved by Newton with line search (the accuracy reference)
+    Implicit,      // backward Euler solved by Newton with line search
+    // Second order (docs/dynamics.md, "Integrators"). The implicit ones come
+    // in two forms, as backward Euler: solved by Newton to tolerance, and
+    // linearised at the step's start (one K per step, CG budgets allowed).
+    Newmark,                 // Newmark-beta (beta = 1/4, gamma = 1/2: the trapezoidal rule), Newton
+    NewmarkLinear,           // the same, linearised
+    GeneralizedAlpha,        // Chung-Hulbert generalized-alpha (rho_inf), Newton
+    GeneralizedAlphaLinear,  // the same, linearised
+    Bdf2,                    // BDF2 (backward Euler on its first step and after a change of step size), Newton
+    Bdf2Linear,              // the same, linearised
+    Verlet,                  // velocity Verlet / central differences: explicit, never builds K
+};
+
+// Whether the integrator is one of the linearised forms (one K per step).
+bool is_linearised(Integrator i);
+// Whether it is explicit (never builds K).
+bool is_explicit(Integrator i);
+
+// The integrators' parameters.
+struct IntegratorParameters {
+    double newmark_beta = 0.25;  // Newmark: 0 < beta <= 1/2
+    double newmark_gamma = 0.5;  // Newmark: 1/2 <= gamma <= 1 (1/2: second order)
+    // Generalized-alpha: the spectral radius at infinite frequency, in [0, 1]
+    // (1: no numerical damping, the trapezoidal rule; 0: the highest
+    // frequencies annihilated in one step).
+    double rho_inf = 0.8;
 };
 
 enum class LinearSolver {
@@ -66,6 +92,13 @@ struct SolverSettings {
     bool fail_on_inverted = false;
 };
 
+// A value given at times (s), linear in between, constant before the first
+// and after the last (keyframe_value).
+struct Keyframe {
+    double time, value;
+};
+double keyframe_value(const std::vector<Keyframe>& keys, double t);
+
 // A vertex driven to a target position.
 struct Prescribed {
     index_t vertex;
@@ -83,7 +116,19 @@ struct Scene {
     std::vector<index_t> fixed;              // held at their rest position
     std::vector<Prescribed> prescribed;      // moved linearly from rest to target
     int prescribed_steps = 1;                // dynamics: steps over which targets are reached
+    // Dynamics: the fraction of the prescribed displacements (target - rest)
+    // at time t, piecewise linear (keyframe_value); empty: the linear ramp
+    // over prescribed_steps.
+    std::vector<Keyframe> prescribed_keyframes;
+    // An external load (N per dof, 3 #V; empty: none) scaled at time t by
+    // load_keyframes (empty: 1); added to the application's
+    // Simulator::external_forces().
+    std::vector<double> load;
+    std::vector<Keyframe> load_keyframes;
+    // The initial state (3 #V each; empty: at rest).
+    std::vector<double> initial_displacement, initial_velocity;
     Integrator integrator = Integrator::SemiImplicit;
+    IntegratorParameters integrator_parameters;
     double dt = 1e-3;                        // s
     int steps = 1000;
     SolverSettings solver;
@@ -97,6 +142,8 @@ struct Scene {
 };
 
 const char* to_string(Integrator i);
+// Every integrator with its name (scene JSON, CLI, Python), in enum order.
+const std::vector<std::pair<const char*, Integrator>>& integrator_names();
 const char* to_string(LinearSolver s);
 
 }  // namespace edgefem

@@ -31,7 +31,8 @@ struct Scaled {
 // Newton's residual (ops::newton_terms) over all dofs: R (0 on constrained
 // dofs) and the inertia terms written, and the sums of h.u, |h u|, the
 // kinetic terms and their sizes returned. u0 / upred / d / K0d are read
-// only when `dynamic`.
+// only when `dynamic`; c_i, c_d: the scheme's inertia and damping
+// coefficients (ops::newton_terms).
 template <class S>
 struct NewtonResidualArgs {
     double* R;
@@ -45,7 +46,24 @@ struct NewtonResidualArgs {
     const double* K0d;
     const std::uint8_t* free_dof;
     bool dynamic;
-    double T, alpha, c_b;
+    double c_i, c_d, alpha, c_b;
+};
+
+// The load of an implicit scheme (ops::dynamic_load): out = (c_h h + c_r r +
+// c_a m a) / (m if per_mass), 0 on constrained dofs; a and K0v are read only
+// when c_a != 0 and beta != 0.
+template <class S>
+struct DynamicLoadArgs {
+    double* out;
+    const double* h;
+    const S* f;
+    const S* v;
+    const double* a;
+    const double* K0v;
+    const double* mass;  // #V
+    const std::uint8_t* free_dof;
+    double alpha, beta, c_h, c_r, c_a;
+    bool per_mass;
 };
 
 // The fixed and prescribed vertices: vertex[k] and its final displacement
@@ -96,6 +114,24 @@ public:
     // u = u_start + step du.
     virtual void line_search_point(S* u, const double* u_start, const double* du, double step,
                                    std::size_t n) const = 0;
+    // The second-order integrators (ops::history_combination): upred = cp .
+    // (u, v, h1, h2), ud = cd . (u, v, h1, h2); h2 (and h1) may be null
+    // when their coefficients are 0.
+    virtual void history_predict(double* upred, double* ud, const S* u, const S* v, const double* h1,
+                                 const double* h2, const std::array<double, 4>& cp, const std::array<double, 4>& cd,
+                                 std::size_t n) const = 0;
+    // After their solve: v = c_v (u - ud) on free dofs, cvel on constrained
+    // ones; a (when not null) = c_a (u - upred) on free dofs, 0 on
+    // constrained ones.
+    virtual void history_update(S* v, double* a, const S* u, const double* upred, const double* ud,
+                                const double* cvel, const std::uint8_t* free_dof, double c_v, double c_a,
+                                std::size_t n) const = 0;
+    virtual void dynamic_load(const DynamicLoadArgs<S>& a, std::size_t n) const = 0;
+    // Velocity Verlet's half kick (ops::verlet_kick) on free dofs, x = v on
+    // constrained ones.
+    virtual void verlet_kick(double* x, const S* v, const double* h, const S* f, const double* mass,
+                             const std::uint8_t* free_dof, double t, double alpha_e, double alpha_i,
+                             std::size_t n) const = 0;
 
     // --- constraints (over their dofs) ---
     // vel = (fraction disp - u) / T on the constrained dofs.

@@ -50,21 +50,51 @@ EDGEFEM_HOST_DEVICE inline double system_diagonal(double c_m, double m, double x
 
 // Newton's residual at one dof of the incremental potential (newton.hpp):
 // r = f - h + inertia on the free dofs, and the kinetic part of the
-// potential; e = u - upred, d = u - u0, K0d = (K0 d) at the dof.
+// potential; e = u - upred, d = u - ud, K0d = (K0 d) at the dof. The
+// scheme's coefficients: c_i on the inertia (1 / T^2 for backward Euler),
+// c_d on the damping (1 / T).
 struct NewtonTerms {
     double r = 0, inertia = 0, kinetic = 0;
 };
 EDGEFEM_HOST_DEVICE inline NewtonTerms newton_terms(bool dynamic, double f, double h, double u, double m, double upred,
-                                                    double d, double K0d, double T, double alpha, double c_b) {
+                                                    double d, double K0d, double c_i, double c_d, double alpha,
+                                                    double c_b) {
     NewtonTerms t;
     t.r = f - h;
     if (dynamic) {
         const double e = u - upred;
-        t.inertia = m * e / (T * T) + alpha * m * d / T + c_b * K0d;
+        t.inertia = c_i * m * e + c_d * alpha * m * d + c_b * K0d;
         t.r += t.inertia;
-        t.kinetic = 0.5 * m * e * e / (T * T) + 0.5 * alpha * m * d * d / T + 0.5 * c_b * d * K0d;
+        t.kinetic = 0.5 * c_i * m * e * e + 0.5 * c_d * alpha * m * d * d + 0.5 * c_b * d * K0d;
     }
     return t;
+}
+
+// The second-order integrators' predictions (integrators/implicit_step.hpp):
+// c0 u + c1 v + c2 h1 + c3 h2 from the state and two history values.
+EDGEFEM_HOST_DEVICE inline double history_combination(double c0, double c1, double c2, double c3, double u, double v,
+                                                       double h1, double h2) {
+    return c0 * u + c1 * v + c2 * h1 + c3 * h2;
+}
+
+// The load of an implicit scheme at one dof: (c_h h + c_r r + c_a m a) /
+// (m if per_mass, else 1), with r = h - f - alpha m v - beta K0v the
+// unbalanced force at the step's start (an acceleration: m a = r;
+// generalized-alpha's load: its weighted start terms).
+EDGEFEM_HOST_DEVICE inline double dynamic_load(double h, double f, double v, double a, double K0v, double m,
+                                               double alpha, double beta, double c_h, double c_r, double c_a,
+                                               bool per_mass) {
+    const double r = h - f - alpha * m * v - beta * K0v;
+    const double out = c_h * h + c_r * r + c_a * m * a;
+    return per_mass ? out / m : out;
+}
+
+// Velocity Verlet's half kick: (v (1 - t alpha_e) + t (h - f) / m) / (1 + t
+// alpha_i), t = T / 2: mass damping explicit in the first half, implicit in
+// the second (together the trapezoidal rule, second order).
+EDGEFEM_HOST_DEVICE inline double verlet_kick(double v, double t, double h, double f, double m, double alpha_e,
+                                              double alpha_i) {
+    return (v * (1 - t * alpha_e) + t * (h - f) / m) / (1 + t * alpha_i);
 }
 
 // One vertex's twice kinetic energy m |v|^2 and gravity work m g.u.
