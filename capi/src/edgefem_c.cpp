@@ -7,8 +7,10 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <string>
+#include <unordered_set>
 #include <utility>
 
 #include "edgefem/core/error.hpp"
@@ -101,6 +103,43 @@ void require_finite(const double* a, size_t n, const char* name, bool per_vertex
                     (per_vertex ? " (vertex " + std::to_string(i / 3) + ")" : std::string()));
 }
 
+// The handles create functions returned and no destroy has freed yet, so
+// that destroying one twice (or a pointer never returned) is a no-op. Left
+// alive at exit: a destroy from another static destructor stays safe.
+template <class Handle>
+struct LiveHandles {
+    std::mutex mutex;
+    std::unordered_set<const Handle*> live;
+
+    static LiveHandles& get() {
+        static auto* registry = new LiveHandles;
+        return *registry;
+    }
+    // Registers `h` (owned until then) and hands it to the caller.
+    static Handle* track(std::unique_ptr<Handle> h) {
+        LiveHandles& r = get();
+        const std::lock_guard lock(r.mutex);
+        r.live.insert(h.get());
+        return h.release();
+    }
+    // Whether `h` was live (it no longer is).
+    static bool forget(const Handle* h) {
+        LiveHandles& r = get();
+        const std::lock_guard lock(r.mutex);
+        return r.live.erase(h) == 1;
+    }
+};
+
+template <class Handle, class... Args>
+Handle* new_handle(Args&&... args) {
+    return LiveHandles<Handle>::track(std::make_unique<Handle>(std::forward<Args>(args)...));
+}
+
+template <class Handle>
+void destroy_handle(Handle* h) {
+    if (h && LiveHandles<Handle>::forget(h)) delete h;
+}
+
 edgefem::Scene default_scene_for(edgefem::Mesh mesh) {
     edgefem::Scene s;
     s.mesh = std::move(mesh);
@@ -115,7 +154,7 @@ edgefem_status make_scene(const char* fn, edgefem_scene** out, edgefem::Mesh (*b
         require(out, "out");
         edgefem::Mesh mesh = build(ctx);
         edgefem::validate_mesh(mesh);
-        *out = new edgefem_scene{default_scene_for(std::move(mesh))};
+        *out = new_handle<edgefem_scene>(edgefem_scene{default_scene_for(std::move(mesh))});
     }, invalid_status);
 }
 
@@ -193,11 +232,11 @@ edgefem_status edgefem_scene_create_from_json(const char* path, edgefem_scene** 
         require(out, "out");
         require(path, "path");
         edgefem::SceneFile file = edgefem::load_scene(path);
-        *out = new edgefem_scene{std::move(file.scene)};
+        *out = new_handle<edgefem_scene>(edgefem_scene{std::move(file.scene)});
     }, EDGEFEM_ERROR_FILE);
 }
 
-void edgefem_scene_destroy(edgefem_scene* scene) { delete scene; }
+void edgefem_scene_destroy(edgefem_scene* scene) { destroy_handle(scene); }
 
 edgefem_status edgefem_scene_counts(const edgefem_scene* scene, int32_t* num_vertices, int32_t* num_tets) {
     return guard("edgefem_scene_counts", [&] {
@@ -214,6 +253,17 @@ edgefem_status edgefem_scene_get_rest_positions(const edgefem_scene* scene, doub
         const auto& X = scene->scene.mesh.X;
         require_count(count, X.size(), "out");
         std::copy(X.begin(), X.end(), out);
+    });
+}
+
+edgefem_status edgefem_scene_get_tets(const edgefem_scene* scene, int32_t* out, size_t count) {
+    return guard("edgefem_scene_get_tets", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        const auto& T = scene->scene.mesh.tets;
+        if (count != T.size())
+            invalid("out: count is " + std::to_string(count) + ", expected 4 x #T = " + std::to_string(T.size()));
+        std::copy(T.begin(), T.end(), out);
     });
 }
 
@@ -239,6 +289,27 @@ edgefem_status edgefem_scene_set_fixed(edgefem_scene* scene, const int32_t* vert
     });
 }
 
+edgefem_status edgefem_scene_set_prescribed(edgefem_scene* scene, const int32_t* vertices, const double* targets,
+                                            size_t count, int32_t steps) {
+    return guard("edgefem_scene_set_prescribed", [&] {
+        require(scene, "scene");
+        if (count > 0) {
+            require(vertices, "vertices");
+            require(targets, "targets");
+        }
+        if (steps < 1) invalid("steps must be >= 1, got " + std::to_string(steps));
+        require_finite(targets, 3 * count, "targets");
+        edgefem::Scene s = scene->scene;  // checked whole before it replaces the scene's
+        s.prescribed.clear();
+        for (size_t i = 0; i < count; ++i)
+            s.prescribed.push_back({vertices[i], {targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]}});
+        s.prescribed_steps = steps;
+        s.validate();  // vertices in range, not fixed, not twice: messages name prescribed[i]
+        scene->scene.prescribed = std::move(s.prescribed);
+        scene->scene.prescribed_steps = steps;
+    });
+}
+
 edgefem_status edgefem_scene_set_gravity(edgefem_scene* scene, double gx, double gy, double gz) {
     return guard("edgefem_scene_set_gravity", [&] {
         require(scene, "scene");
@@ -256,25 +327,29 @@ edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt) {
     });
 }
 
-edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator) {
+edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, int32_t integrator) {
     return guard("edgefem_scene_set_integrator", [&] {
         require(scene, "scene");
         switch (integrator) {
             case EDGEFEM_EXPLICIT: scene->scene.integrator = edgefem::Integrator::Explicit; break;
             case EDGEFEM_SEMI_IMPLICIT: scene->scene.integrator = edgefem::Integrator::SemiImplicit; break;
             case EDGEFEM_IMPLICIT: scene->scene.integrator = edgefem::Integrator::Implicit; break;
-            default: invalid("unknown integrator " + std::to_string(int(integrator)));
+            default:
+                invalid("integrator: " + std::to_string(integrator) +
+                        " is not an edgefem_integrator (EDGEFEM_EXPLICIT 0, EDGEFEM_SEMI_IMPLICIT 1, EDGEFEM_IMPLICIT 2)");
         }
     });
 }
 
-edgefem_status edgefem_scene_set_model(edgefem_scene* scene, edgefem_model model) {
+edgefem_status edgefem_scene_set_model(edgefem_scene* scene, int32_t model) {
     return guard("edgefem_scene_set_model", [&] {
         require(scene, "scene");
         switch (model) {
             case EDGEFEM_MODEL_FE: scene->scene.model = edgefem::ModelKind::FE; break;
             case EDGEFEM_MODEL_SN: scene->scene.model = edgefem::ModelKind::SN; break;
-            default: invalid("unknown model " + std::to_string(int(model)));
+            default:
+                invalid("model: " + std::to_string(model) +
+                        " is not an edgefem_model (EDGEFEM_MODEL_FE 0, EDGEFEM_MODEL_SN 1)");
         }
     });
 }
@@ -332,7 +407,7 @@ edgefem_status edgefem_sim_create_with(const edgefem_scene* scene, const edgefem
     return guard("edgefem_sim_create_with", [&] {
         require(scene, "scene");
         require(out, "out");
-        *out = new edgefem_sim(edgefem::make_simulator<double>(scene->scene, to_run_options(run)));
+        *out = new_handle<edgefem_sim>(edgefem::make_simulator<double>(scene->scene, to_run_options(run)));
     });
 }
 
@@ -341,11 +416,11 @@ edgefem_status edgefem_sim_create(const edgefem_scene* scene, edgefem_sim** out)
     return guard("edgefem_sim_create", [&] {
         require(scene, "scene");
         require(out, "out");
-        *out = new edgefem_sim(edgefem::make_simulator<double>(scene->scene, {}));
+        *out = new_handle<edgefem_sim>(edgefem::make_simulator<double>(scene->scene, edgefem::RunOptions{}));
     });
 }
 
-void edgefem_sim_destroy(edgefem_sim* sim) { delete sim; }
+void edgefem_sim_destroy(edgefem_sim* sim) { destroy_handle(sim); }
 
 edgefem_status edgefem_sim_num_vertices(const edgefem_sim* sim, int32_t* out) {
     return guard("edgefem_sim_num_vertices", [&] {
