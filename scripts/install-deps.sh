@@ -14,7 +14,7 @@ packages=(
   nlohmann-json3-dev  # scene files
   python3-getfem      # tests: GetFEM reference for `edgefem static` (system python3)
   libfmt-dev
-  pybind11-dev        # Python bindings (build/python/edgefem*.so)
+  pybind11-dev        # Python bindings (build/python/edgefem/_edgefem*.so)
   python3-dev         # Python headers for the bindings
   python3-numpy       # Python bindings: arrays (system python3)
   python3-matplotlib  # bench/report: the plots of docs/benchmarks.md (system python3)

@@ -7,8 +7,10 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <string>
+#include <unordered_set>
 #include <utility>
 
 #include "edgefem/core/error.hpp"
@@ -101,6 +103,43 @@ void require_finite(const double* a, size_t n, const char* name, bool per_vertex
                     (per_vertex ? " (vertex " + std::to_string(i / 3) + ")" : std::string()));
 }
 
+// The handles create functions returned and no destroy has freed yet, so
+// that destroying one twice (or a pointer never returned) is a no-op. Left
+// alive at exit: a destroy from another static destructor stays safe.
+template <class Handle>
+struct LiveHandles {
+    std::mutex mutex;
+    std::unordered_set<const Handle*> live;
+
+    static LiveHandles& get() {
+        static auto* registry = new LiveHandles;
+        return *registry;
+    }
+    // Registers `h` (owned until then) and hands it to the caller.
+    static Handle* track(std::unique_ptr<Handle> h) {
+        LiveHandles& r = get();
+        const std::lock_guard lock(r.mutex);
+        r.live.insert(h.get());
+        return h.release();
+    }
+    // Whether `h` was live (it no longer is).
+    static bool forget(const Handle* h) {
+        LiveHandles& r = get();
+        const std::lock_guard lock(r.mutex);
+        return r.live.erase(h) == 1;
+    }
+};
+
+template <class Handle, class... Args>
+Handle* new_handle(Args&&... args) {
+    return LiveHandles<Handle>::track(std::make_unique<Handle>(std::forward<Args>(args)...));
+}
+
+template <class Handle>
+void destroy_handle(Handle* h) {
+    if (h && LiveHandles<Handle>::forget(h)) delete h;
+}
+
 edgefem::Scene default_scene_for(edgefem::Mesh mesh) {
     edgefem::Scene s;
     s.mesh = std::move(mesh);
@@ -119,7 +158,7 @@ edgefem_status make_scene(const char* fn, edgefem_scene** out, edgefem::Mesh (*b
         options.fix_orientation_hint = "reorder their vertices before passing the mesh (the C API does not reorient)";
         options.compact_hint = "leave them out of the arrays passed";
         edgefem::validate_mesh(mesh, options);
-        *out = new edgefem_scene{default_scene_for(std::move(mesh))};
+        *out = new_handle<edgefem_scene>(edgefem_scene{default_scene_for(std::move(mesh))});
     }, invalid_status);
 }
 
@@ -197,11 +236,11 @@ edgefem_status edgefem_scene_create_from_json(const char* path, edgefem_scene** 
         require(out, "out");
         require(path, "path");
         edgefem::SceneFile file = edgefem::load_scene(path);
-        *out = new edgefem_scene{std::move(file.scene)};
+        *out = new_handle<edgefem_scene>(edgefem_scene{std::move(file.scene)});
     }, EDGEFEM_ERROR_FILE);
 }
 
-void edgefem_scene_destroy(edgefem_scene* scene) { delete scene; }
+void edgefem_scene_destroy(edgefem_scene* scene) { destroy_handle(scene); }
 
 edgefem_status edgefem_scene_counts(const edgefem_scene* scene, int32_t* num_vertices, int32_t* num_tets) {
     return guard("edgefem_scene_counts", [&] {
@@ -218,6 +257,17 @@ edgefem_status edgefem_scene_get_rest_positions(const edgefem_scene* scene, doub
         const auto& X = scene->scene.mesh.X;
         require_count(count, X.size(), "out");
         std::copy(X.begin(), X.end(), out);
+    });
+}
+
+edgefem_status edgefem_scene_get_tets(const edgefem_scene* scene, int32_t* out, size_t count) {
+    return guard("edgefem_scene_get_tets", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        const auto& T = scene->scene.mesh.tets;
+        if (count != T.size())
+            invalid("out: count is " + std::to_string(count) + ", expected 4 x #T = " + std::to_string(T.size()));
+        std::copy(T.begin(), T.end(), out);
     });
 }
 
@@ -243,6 +293,27 @@ edgefem_status edgefem_scene_set_fixed(edgefem_scene* scene, const int32_t* vert
     });
 }
 
+edgefem_status edgefem_scene_set_prescribed(edgefem_scene* scene, const int32_t* vertices, const double* targets,
+                                            size_t count, int32_t steps) {
+    return guard("edgefem_scene_set_prescribed", [&] {
+        require(scene, "scene");
+        if (count > 0) {
+            require(vertices, "vertices");
+            require(targets, "targets");
+        }
+        if (steps < 1) invalid("steps must be >= 1, got " + std::to_string(steps));
+        require_finite(targets, 3 * count, "targets");
+        edgefem::Scene s = scene->scene;  // checked whole before it replaces the scene's
+        s.prescribed.clear();
+        for (size_t i = 0; i < count; ++i)
+            s.prescribed.push_back({vertices[i], {targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]}});
+        s.prescribed_steps = steps;
+        s.validate();  // vertices in range, not fixed, not twice: messages name prescribed[i]
+        scene->scene.prescribed = std::move(s.prescribed);
+        scene->scene.prescribed_steps = steps;
+    });
+}
+
 edgefem_status edgefem_scene_set_gravity(edgefem_scene* scene, double gx, double gy, double gz) {
     return guard("edgefem_scene_set_gravity", [&] {
         require(scene, "scene");
@@ -260,7 +331,7 @@ edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt) {
     });
 }
 
-edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator) {
+edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, int32_t integrator) {
     return guard("edgefem_scene_set_integrator", [&] {
         require(scene, "scene");
         // The C values are the enum's order (integrator_names()).
@@ -268,7 +339,8 @@ edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integr
                       int(edgefem::Integrator::Verlet) == EDGEFEM_VERLET);
         const auto& names = edgefem::integrator_names();
         if (int(integrator) < 0 || std::size_t(integrator) >= names.size())
-            invalid("unknown integrator " + std::to_string(int(integrator)));
+            invalid("integrator: " + std::to_string(integrator) + " is not an edgefem_integrator (0 to " +
+                    std::to_string(names.size() - 1) + ")");
         scene->scene.integrator = names[std::size_t(integrator)].second;
     });
 }
@@ -351,13 +423,15 @@ edgefem_status edgefem_scene_set_generalized_alpha(edgefem_scene* scene, double 
     });
 }
 
-edgefem_status edgefem_scene_set_model(edgefem_scene* scene, edgefem_model model) {
+edgefem_status edgefem_scene_set_model(edgefem_scene* scene, int32_t model) {
     return guard("edgefem_scene_set_model", [&] {
         require(scene, "scene");
         switch (model) {
             case EDGEFEM_MODEL_FE: scene->scene.model = edgefem::ModelKind::FE; break;
             case EDGEFEM_MODEL_SN: scene->scene.model = edgefem::ModelKind::SN; break;
-            default: invalid("unknown model " + std::to_string(int(model)));
+            default:
+                invalid("model: " + std::to_string(model) +
+                        " is not an edgefem_model (EDGEFEM_MODEL_FE 0, EDGEFEM_MODEL_SN 1)");
         }
     });
 }
@@ -415,7 +489,7 @@ edgefem_status edgefem_sim_create_with(const edgefem_scene* scene, const edgefem
     return guard("edgefem_sim_create_with", [&] {
         require(scene, "scene");
         require(out, "out");
-        *out = new edgefem_sim(edgefem::make_simulator<double>(scene->scene, to_run_options(run)));
+        *out = new_handle<edgefem_sim>(edgefem::make_simulator<double>(scene->scene, to_run_options(run)));
     });
 }
 
@@ -424,11 +498,11 @@ edgefem_status edgefem_sim_create(const edgefem_scene* scene, edgefem_sim** out)
     return guard("edgefem_sim_create", [&] {
         require(scene, "scene");
         require(out, "out");
-        *out = new edgefem_sim(edgefem::make_simulator<double>(scene->scene, {}));
+        *out = new_handle<edgefem_sim>(edgefem::make_simulator<double>(scene->scene, edgefem::RunOptions{}));
     });
 }
 
-void edgefem_sim_destroy(edgefem_sim* sim) { delete sim; }
+void edgefem_sim_destroy(edgefem_sim* sim) { destroy_handle(sim); }
 
 edgefem_status edgefem_sim_num_vertices(const edgefem_sim* sim, int32_t* out) {
     return guard("edgefem_sim_num_vertices", [&] {

@@ -243,6 +243,11 @@ ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options) {
     return report;
 }
 
+void check_mesh_indices(const Mesh& mesh) {
+    check_structure(mesh);
+    check_indices(mesh);
+}
+
 void check_mesh(const Mesh& mesh, const ValidationOptions& options) {
     const std::vector<index_t> inverted = check_all_but_orientation(mesh, options);
     if (!inverted.empty()) throw_inverted(mesh, inverted, options);

@@ -13,6 +13,7 @@
 
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/output_file.hpp"
+#include "edgefem/core/validate_mesh.hpp"
 
 namespace edgefem {
 
@@ -74,6 +75,7 @@ std::string xml_escape(const std::string& s) {
 }  // namespace
 
 void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& fields) {
+    check_mesh_indices(mesh);  // connectivity inside the mesh, before a byte is written
     const index_t nv = mesh.num_vertices(), nt = mesh.num_tets();
     Output out(path);
     out << "<?xml version=\"1.0\"?>\n"

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/finite_input.hpp"
 #include "edgefem/partition/permute_mesh.hpp"
 
 namespace edgefem {
@@ -104,6 +105,9 @@ SimulationError to_user_numbering(const SimulationError& e, const std::vector<in
 template <class S>
 void OrderedSimulator<S>::push() {
     if (identity()) return;
+    require_finite_vectors<S>(u_, "displacement");
+    require_finite_vectors<S>(v_, "velocity");
+    require_finite_vectors<S>(fext_, "external_forces");
     gather<S, S>(u_, sim_.displacement(), new_of_old_, true);
     gather<S, S>(v_, sim_.velocity(), new_of_old_, true);
     gather<S, S>(fext_, sim_.external_forces(), new_of_old_, true);
@@ -119,6 +123,7 @@ void OrderedSimulator<S>::pull() {
 
 template <class S>
 const StepStats& OrderedSimulator<S>::step() {
+    const InUseFlag::Claim claim(in_use_, "step");
     push();
     try {
         const StepStats& st = sim_.step();
@@ -132,6 +137,7 @@ const StepStats& OrderedSimulator<S>::step() {
 
 template <class S>
 StaticResult OrderedSimulator<S>::solve_static() {
+    const InUseFlag::Claim claim(in_use_, "solve_static");
     push();
     try {
         const StaticResult r = sim_.solve_static();
@@ -145,6 +151,7 @@ StaticResult OrderedSimulator<S>::solve_static() {
 
 template <class S>
 Energies OrderedSimulator<S>::energies() {
+    const InUseFlag::Claim claim(in_use_, "energies");
     push();
     return sim_.energies();
 }

@@ -1,6 +1,14 @@
-// The `edgefem` Python module (pybind11): meshes, scenes, the Simulator with
-// numpy views that alias its state, the elastic kernels, VTU output and a
-// small benchmark entry point. Vectors are numpy arrays of shape (#V, 3).
+// The `edgefem` Python module (pybind11; the extension edgefem._edgefem of
+// the package edgefem): meshes, scenes, the Simulator with numpy views that
+// alias its state, the elastic kernels, VTU output and a small benchmark
+// entry point. Vectors are numpy arrays of shape (#V, 3).
+//
+// Hostile input (issues #26, #27): every array argument is checked for its
+// exact shape and dtype (no flattening, wrapping or truncation) and vectors
+// for NaN, each error naming the argument; a mesh is validated before any
+// kernel touches it; what the simulator holds is read-only; a view never
+// outlives its storage (setters copy into place, and a scene's mesh is not
+// reallocated while a view of it is alive).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -8,14 +16,19 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "lab/deformations.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/finite_input.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/scene_json.hpp"
@@ -44,16 +57,75 @@ py::array view(T* data, py::ssize_t rows, py::ssize_t cols, py::handle base, boo
     return a;
 }
 
-// Checks that `a` holds exactly `n` values (any shape, e.g. (#V, 3) or 3 #V).
-void require_size(const py::array& a, std::size_t n, const char* what) {
-    if (std::size_t(a.size()) != n)
-        throw InvalidArgument(std::string(what) + ": expected " + std::to_string(n) + " values (#V x 3), got " +
-                              std::to_string(a.size()));
+std::string shape_of(const py::array& a) {
+    std::string out = "(";
+    for (py::ssize_t d = 0; d < a.ndim(); ++d) out += (d ? ", " : "") + std::to_string(a.shape(d));
+    return out + (a.ndim() == 1 ? ",)" : ")");
 }
 
-std::vector<double> to_vector(const InArray& a, std::size_t n, const char* what) {
-    require_size(a, n, what);
-    return std::vector<double>(a.data(), a.data() + n);
+std::string dtype_of(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+
+// `obj` as a numpy array (a list becomes one); the error names the argument.
+py::array as_array(py::handle obj, const std::string& name) {
+    if (py::isinstance<py::array>(obj)) return py::reinterpret_borrow<py::array>(obj);
+    try {
+        return py::module_::import("numpy").attr("asarray")(obj);
+    } catch (py::error_already_set& e) {
+        throw InvalidArgument(name + ": not convertible to a numpy array (" + e.what() + ")");
+    }
+}
+
+void require_shape(const py::array& a, const std::string& name, py::ssize_t rows, py::ssize_t cols, const char* rows_name) {
+    if (a.ndim() != 2 || a.shape(1) != cols || (rows >= 0 && a.shape(0) != rows))
+        throw InvalidArgument(name + ": expected shape (" + (rows >= 0 ? std::to_string(rows) : rows_name) + ", " +
+                              std::to_string(cols) + "), got " + shape_of(a));
+}
+
+// A (rows, 3) array of real numbers (rows < 0: any number) as float64, C
+// order: float64 as given, other real floats and integers converted; any
+// other dtype or shape is an error naming `name`. `finite`: NaN and infinity
+// are errors too, naming the vertex.
+InArray vectors_arg(py::handle obj, const std::string& name, py::ssize_t rows, bool finite) {
+    const py::array a = as_array(obj, name);
+    const char kind = a.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u')
+        throw InvalidArgument(name + ": dtype " + dtype_of(a) +
+                              " is not a real number type (expected float64; other floats and integers are converted)");
+    require_shape(a, name, rows, 3, "N");
+    InArray out = InArray::ensure(a);
+    if (!out) throw py::error_already_set();
+    if (finite) require_finite_vectors(std::span<const double>(out.data(), std::size_t(out.size())), name);
+    return out;
+}
+
+// A (T, 4) integer array of vertex indices as index_t, refusing floats and
+// any value a 32-bit index cannot hold (instead of truncating or wrapping).
+// Whether the indices are in range is the mesh validation's to say.
+std::vector<index_t> tets_arg(py::handle obj) {
+    const py::array a = as_array(obj, "tets");
+    const char kind = a.dtype().kind();
+    if (kind != 'i' && kind != 'u')
+        throw InvalidArgument("tets: dtype " + dtype_of(a) + " is not an integer type (vertex indices)");
+    require_shape(a, "tets", -1, 4, "T");
+    std::vector<index_t> tets(std::size_t(a.size()));
+    const auto copy = [&](const auto& values) {
+        for (std::size_t i = 0; i < tets.size(); ++i) {
+            const auto v = values.data()[i];
+            using V = std::decay_t<decltype(v)>;
+            constexpr V hi = V(std::numeric_limits<index_t>::max());
+            bool fits = v <= hi;
+            if constexpr (std::is_signed_v<V>) fits = fits && v >= V(std::numeric_limits<index_t>::min());
+            if (!fits)
+                throw InvalidArgument("tets[" + std::to_string(i / 4) + ", " + std::to_string(i % 4) +
+                                      "] = " + std::to_string(v) + " does not fit a 32-bit vertex index");
+            tets[i] = index_t(v);
+        }
+    };
+    if (kind == 'u')
+        copy(py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(a));
+    else
+        copy(py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a));
+    return tets;
 }
 
 py::array_t<double> new_vectors(const std::vector<double>& v) {
@@ -62,25 +134,78 @@ py::array_t<double> new_vectors(const std::vector<double>& v) {
     return out;
 }
 
-Mesh mesh_from_arrays(const InArray& X, const InIndex& tets, std::optional<std::vector<int>> region) {
-    if (X.size() % 3 != 0) throw InvalidArgument("X: size " + std::to_string(X.size()) + " is not a multiple of 3");
-    if (tets.size() % 4 != 0)
-        throw InvalidArgument("tets: size " + std::to_string(tets.size()) + " is not a multiple of 4");
+Mesh mesh_from_arrays(py::handle X, py::handle tets, std::optional<std::vector<int>> region) {
+    const InArray x = vectors_arg(X, "X", -1, false);
     Mesh m;
-    m.X.assign(X.data(), X.data() + X.size());
-    m.tets.assign(tets.data(), tets.data() + tets.size());
+    m.X.assign(x.data(), x.data() + x.size());
+    m.tets = tets_arg(tets);
     if (region) {
-        if (region->size() != std::size_t(m.num_tets())) throw InvalidArgument("region: expected one id per tet");
+        if (region->size() != std::size_t(m.num_tets()))
+            throw InvalidArgument("region: expected one id per tet (" + std::to_string(m.num_tets()) + "), got " +
+                                  std::to_string(region->size()));
         m.region = *region;
     }
     return m;
 }
 
+// A mesh's arrays as numpy views kept alive by `owner` (read-only unless
+// `writeable`; tets always are), and its repr: shared by Mesh and MeshView.
+py::array mesh_X(const Mesh& me, py::handle owner, bool writeable) {
+    return view(const_cast<double*>(me.X.data()), me.num_vertices(), 3, owner, writeable);
+}
+py::array mesh_tets(const Mesh& me, py::handle owner) {
+    return view(const_cast<index_t*>(me.tets.data()), me.num_tets(), 4, owner, false);
+}
+std::string mesh_repr(const char* cls, const Mesh& me) {
+    return std::string("<edgefem.") + cls + " " + std::to_string(me.num_vertices()) + " vertices, " +
+           std::to_string(me.num_tets()) + " tets>";
+}
+
+// Replaces a scene's mesh from Python. Same counts: copied into the arrays
+// numpy views may show (they then show the new mesh). Other counts
+// reallocate, refused while a Mesh object for the scene's mesh (which every
+// view of it keeps alive) exists: a view would point into freed memory.
+void set_scene_mesh(Scene& s, const Mesh& m) {
+    Mesh& old = s.mesh;
+    if (m.num_vertices() == old.num_vertices() && m.num_tets() == old.num_tets()) {
+        if (&m == &old) return;
+        std::copy(m.X.begin(), m.X.end(), old.X.begin());
+        std::copy(m.tets.begin(), m.tets.end(), old.tets.begin());
+        old.region = m.region;
+        old.source = m.source;
+        return;
+    }
+    if (py::detail::get_object_handle(&old, py::detail::get_type_info(typeid(Mesh))))
+        throw InvalidArgument("Scene.mesh: the new mesh has " + std::to_string(m.num_vertices()) + " vertices and " +
+                              std::to_string(m.num_tets()) + " tets, the scene's " +
+                              std::to_string(old.num_vertices()) + " and " + std::to_string(old.num_tets()) +
+                              ", and a Mesh object or numpy array viewing the scene's mesh is still alive (it would "
+                              "point into freed memory): delete those references first, or build a new Scene");
+    old = m;
+}
+
+// What a Simulator holds, seen from Python: read-only (no setters, numpy
+// arrays flagged read-only); copy() gives objects of one's own. Each view
+// keeps the simulator alive.
+struct MeshView {
+    const Mesh* mesh;
+};
+struct SceneView {
+    const Scene* scene;
+};
+
+py::list prescribed_list(const Scene& s) {
+    py::list out;
+    for (const auto& p : s.prescribed) out.append(py::make_tuple(p.vertex, p.target));
+    return out;
+}
+
 // The elastic kernels on their own, owning a copy of the mesh (the operator
 // keeps a reference to it).
 struct ElasticModel {
+    // Validated first (as a Simulator's scene is): no kernel sees a bad mesh.
     ElasticModel(Mesh m, const Materials& mat, ModelKind kind, Method method, const RunOptions& run)
-        : mesh(std::move(m)), op(make_run_factory<double>(run, make_run_executor(run))(mesh, mat, kind, method)) {}
+        : mesh((check_mesh(m), std::move(m))), op(make_run_factory<double>(run, make_run_executor(run))(mesh, mat, kind, method)) {}
     ElasticModel(const ElasticModel&) = delete;
     ElasticModel& operator=(const ElasticModel&) = delete;
     std::size_t dofs() const { return 3 * std::size_t(mesh.num_vertices()); }
@@ -139,7 +264,7 @@ RunOptions run_options(const std::string& backend, int threads, const std::strin
 
 }  // namespace
 
-PYBIND11_MODULE(edgefem, m) {
+PYBIND11_MODULE(_edgefem, m) {
     m.doc() = "edgefem: edge-based StVK tetrahedral FEM (meshes, scenes, simulator, kernels).";
     m.attr("__version__") = EDGEFEM_VERSION;
     m.attr("has_parallel") = true;  // the CPU back-end's threads (always built)
@@ -188,20 +313,19 @@ PYBIND11_MODULE(edgefem, m) {
     py::enum_<LinearSolver>(m, "LinearSolver").value("CG", LinearSolver::CG).value("Direct", LinearSolver::Direct);
 
     // ---- meshes ----
-    py::class_<Mesh>(m, "Mesh", "Rest positions X (#V, 3) and tets (#T, 4); both are views into the mesh.")
-        .def(py::init(&mesh_from_arrays), py::arg("X"), py::arg("tets"), py::arg("region") = py::none(),
-             "A mesh from arrays (copied; not validated: call validate()).")
+    py::class_<Mesh> mesh_class(m, "Mesh", "Rest positions X (#V, 3) and tets (#T, 4); both are views into the mesh.");
+    mesh_class.def(py::init(&mesh_from_arrays), py::arg("X"), py::arg("tets"), py::arg("region") = py::none(),
+             "A mesh from arrays, copied: X of shape (N, 3), float64 (other real floats and integers are "
+             "converted); tets of shape (T, 4), any integer dtype whose values fit 32 bits (floats are refused). "
+             "Not validated: call validate(); every kernel, Simulator and write_vtu validates it.")
         .def_property(
-            "X", [](py::object self) {
-                Mesh& me = self.cast<Mesh&>();
-                return view(me.X.data(), me.num_vertices(), 3, self);
+            "X", [](py::object self) { return mesh_X(self.cast<Mesh&>(), self, true); },
+            [](Mesh& me, py::handle X) {
+                const InArray x = vectors_arg(X, "X", me.num_vertices(), false);
+                std::copy(x.data(), x.data() + x.size(), me.X.begin());  // into place: views stay valid
             },
-            [](Mesh& me, const InArray& X) { me.X = to_vector(X, me.X.size(), "X"); })
-        .def_property_readonly("tets",
-                               [](py::object self) {
-                                   Mesh& me = self.cast<Mesh&>();
-                                   return view(me.tets.data(), me.num_tets(), 4, self, false);
-                               })
+            "(N, 3) view; assigning copies into it (same shape).")
+        .def_property_readonly("tets", [](py::object self) { return mesh_tets(self.cast<Mesh&>(), self); })
         .def_readwrite("region", &Mesh::region)
         .def_property_readonly("num_vertices", &Mesh::num_vertices)
         .def_property_readonly("num_tets", &Mesh::num_tets)
@@ -215,10 +339,19 @@ PYBIND11_MODULE(edgefem, m) {
             py::arg("fix_orientation") = false,
             "Checks the mesh (raises MeshError naming the element); returns warnings.")
         .def("copy", [](const Mesh& me) { return Mesh(me); })
-        .def("__repr__", [](const Mesh& me) {
-            return "<edgefem.Mesh " + std::to_string(me.num_vertices()) + " vertices, " +
-                   std::to_string(me.num_tets()) + " tets>";
-        });
+        .def("__repr__", [](const Mesh& me) { return mesh_repr("Mesh", me); });
+    py::class_<MeshView>(m, "MeshView", "The mesh a Simulator holds: read-only arrays; copy() gives a Mesh.")
+        .def_property_readonly("X", [](py::object self) { return mesh_X(*self.cast<MeshView&>().mesh, self, false); })
+        .def_property_readonly("tets", [](py::object self) { return mesh_tets(*self.cast<MeshView&>().mesh, self); })
+        .def_property_readonly("region", [](const MeshView& v) { return v.mesh->region; })
+        .def_property_readonly("num_vertices", [](const MeshView& v) { return v.mesh->num_vertices(); })
+        .def_property_readonly("num_tets", [](const MeshView& v) { return v.mesh->num_tets(); })
+        .def("copy", [](const MeshView& v) { return Mesh(*v.mesh); })
+        .def("__repr__", [](const MeshView& v) { return mesh_repr("MeshView", *v.mesh); });
+    // Wherever a Mesh is taken (write_vtu, ElasticModel, ...), a MeshView is
+    // too, as a copy.
+    mesh_class.def(py::init([](const MeshView& v) { return Mesh(*v.mesh); }), py::arg("view"));
+    py::implicitly_convertible<MeshView, Mesh>();
 
     m.def(
         "read_mesh",
@@ -237,13 +370,14 @@ PYBIND11_MODULE(edgefem, m) {
     // ---- output ----
     m.def(
         "write_vtu",
-        [](const std::string& path, const Mesh& mesh, std::optional<InArray> displacement,
-           std::optional<InArray> force) {
+        [](const std::string& path, const Mesh& mesh, py::object displacement, py::object force) {
             VtuFields f;
-            const std::size_t n = 3 * std::size_t(mesh.num_vertices());
-            if (displacement) require_size(*displacement, n, "displacement"), f.displacement = displacement->data();
-            if (force) require_size(*force, n, "force"), f.force = force->data();
-            write_vtu(path, mesh, f);
+            // Not required finite: a blown-up state may be written to look at.
+            InArray u, fo;
+            if (!displacement.is_none())
+                u = vectors_arg(displacement, "displacement", mesh.num_vertices(), false), f.displacement = u.data();
+            if (!force.is_none()) fo = vectors_arg(force, "force", mesh.num_vertices(), false), f.force = fo.data();
+            write_vtu(path, mesh, f);  // checks the connectivity before writing
         },
         py::arg("path"), py::arg("mesh"), py::arg("displacement") = py::none(), py::arg("force") = py::none(),
         "Writes a VTK .vtu frame (points X + displacement).");
@@ -305,7 +439,10 @@ PYBIND11_MODULE(edgefem, m) {
              py::arg("method") = Method::Edge)
         .def_static("from_json", [](const std::string& path) { return load_scene(path).scene; }, py::arg("path"),
                     "Reads and validates a JSON scene file.")
-        .def_readwrite("mesh", &Scene::mesh)
+        .def_property("mesh", [](Scene& s) -> Mesh& { return s.mesh; }, &set_scene_mesh,
+                      py::return_value_policy::reference_internal,
+                      "The scene's mesh (its arrays are views). Assigning copies into it when the counts match; "
+                      "a mesh of other counts replaces it only while no view of the old one is alive.")
         .def_property(
             "material", [](const Scene& s) { return s.materials.fallback; },
             [](Scene& s, const Material& mat) { s.materials = Materials(mat); },
@@ -319,12 +456,7 @@ PYBIND11_MODULE(edgefem, m) {
         .def_readwrite("rayleigh_beta", &Scene::rayleigh_beta)
         .def_readwrite("fixed", &Scene::fixed)
         .def_property(
-            "prescribed",
-            [](const Scene& s) {
-                py::list out;
-                for (const auto& p : s.prescribed) out.append(py::make_tuple(p.vertex, p.target));
-                return out;
-            },
+            "prescribed", &prescribed_list,
             [](Scene& s, const std::vector<std::pair<index_t, std::array<double, 3>>>& ps) {
                 s.prescribed.clear();
                 for (const auto& [v, t] : ps) s.prescribed.push_back({v, t});
@@ -342,7 +474,27 @@ PYBIND11_MODULE(edgefem, m) {
         .def_readwrite("steps", &Scene::steps)
         .def_readwrite("solver", &Scene::solver)
         .def_readwrite("count_inverted_tets", &Scene::count_inverted_tets)
-        .def("validate", &Scene::validate);
+        .def("validate", &Scene::validate)
+        .def("copy", [](const Scene& s) { return Scene(s); });
+    py::class_<SceneView>(m, "SceneView",
+                          "The scene a Simulator holds: read-only (its mesh's arrays too); copy() gives a Scene.")
+        .def_property_readonly("mesh", py::cpp_function([](const SceneView& v) { return MeshView{&v.scene->mesh}; },
+                                                        py::keep_alive<0, 1>()))
+        .def_property_readonly("material", [](const SceneView& v) { return v.scene->materials.fallback; })
+        .def_property_readonly("model", [](const SceneView& v) { return v.scene->model; })
+        .def_property_readonly("method", [](const SceneView& v) { return v.scene->method; })
+        .def_property_readonly("gravity", [](const SceneView& v) { return v.scene->gravity; })
+        .def_property_readonly("rayleigh_alpha", [](const SceneView& v) { return v.scene->rayleigh_alpha; })
+        .def_property_readonly("rayleigh_beta", [](const SceneView& v) { return v.scene->rayleigh_beta; })
+        .def_property_readonly("fixed", [](const SceneView& v) { return v.scene->fixed; })
+        .def_property_readonly("prescribed", [](const SceneView& v) { return prescribed_list(*v.scene); })
+        .def_property_readonly("prescribed_steps", [](const SceneView& v) { return v.scene->prescribed_steps; })
+        .def_property_readonly("integrator", [](const SceneView& v) { return v.scene->integrator; })
+        .def_property_readonly("dt", [](const SceneView& v) { return v.scene->dt; })
+        .def_property_readonly("steps", [](const SceneView& v) { return v.scene->steps; })
+        .def_property_readonly("solver", [](const SceneView& v) { return v.scene->solver; }, "A copy.")
+        .def_property_readonly("count_inverted_tets", [](const SceneView& v) { return v.scene->count_inverted_tets; })
+        .def("copy", [](const SceneView& v) { return Scene(*v.scene); });
     m.def("load_scene", [](const std::string& path) { return load_scene(path).scene; }, py::arg("path"),
           "Scene.from_json(path).");
     m.def("default_scene", &default_scene, "The built-in beam scene of `edgefem simulate`.");
@@ -384,10 +536,9 @@ PYBIND11_MODULE(edgefem, m) {
         };
     };
     auto vec_set = [](std::span<double> (Sim::*get)(), const char* what) {
-        return [get, what](Sim& s, const InArray& a) {
-            auto dst = (s.*get)();
-            require_size(a, dst.size(), what);
-            std::copy(a.data(), a.data() + dst.size(), dst.begin());
+        return [get, what](Sim& s, py::handle a) {
+            const InArray in = vectors_arg(a, what, s.num_vertices(), true);
+            std::copy(in.data(), in.data() + in.size(), (s.*get)().begin());
         };
     };
     py::class_<Sim>(m, "Simulator",
@@ -412,6 +563,7 @@ PYBIND11_MODULE(edgefem, m) {
         .def(
             "run",
             [](Sim& s, int steps) {
+                if (steps < 0) throw InvalidArgument("run: steps must be >= 0, got " + std::to_string(steps));
                 py::gil_scoped_release release;
                 for (int k = 0; k < steps; ++k) s.step();
                 return s.last_stats();
@@ -437,7 +589,10 @@ PYBIND11_MODULE(edgefem, m) {
                                    auto mm = s.lumped_mass();
                                    return view(const_cast<double*>(mm.data()), s.num_vertices(), 1, self, false);
                                })
-        .def_property_readonly("scene", &Sim::scene, py::return_value_policy::reference_internal)
+        .def_property_readonly("scene",
+                               py::cpp_function([](const Sim& s) { return SceneView{&s.scene()}; },
+                                                py::keep_alive<0, 1>()),
+                               "The scene it runs, read-only (copy() gives a Scene to change and run anew).")
         .def_property_readonly("num_vertices", &Sim::num_vertices)
         .def_property_readonly("step_index", &Sim::step_index)
         .def_property_readonly("time", &Sim::time)
@@ -461,15 +616,15 @@ PYBIND11_MODULE(edgefem, m) {
              "variant and layout (their defaults as Simulator's).")
         .def_property_readonly("num_vertices", [](const ElasticModel& em) { return em.mesh.num_vertices(); })
         .def(
-            "energy", [](ElasticModel& em, const InArray& u) {
-                require_size(u, em.dofs(), "u");
+            "energy", [](ElasticModel& em, py::handle u_in) {
+                const InArray u = vectors_arg(u_in, "u", em.mesh.num_vertices(), true);
                 return em.op->energy(u.data());
             },
             py::arg("u"), "W(u).")
         .def(
             "forces",
-            [](ElasticModel& em, const InArray& u) {
-                require_size(u, em.dofs(), "u");
+            [](ElasticModel& em, py::handle u_in) {
+                const InArray u = vectors_arg(u_in, "u", em.mesh.num_vertices(), true);
                 py::array_t<double> f({py::ssize_t(em.mesh.num_vertices()), py::ssize_t(3)});
                 const double W = em.op->forces(u.data(), f.mutable_data(), true);
                 em.have_state = true;
@@ -479,8 +634,8 @@ PYBIND11_MODULE(edgefem, m) {
             py::arg("u"), "(W, f) with f = dW/du, shape (#V, 3).")
         .def(
             "build_stiffness",
-            [](ElasticModel& em, const InArray& u, bool definite) {
-                require_size(u, em.dofs(), "u");
+            [](ElasticModel& em, py::handle u_in, bool definite) {
+                const InArray u = vectors_arg(u_in, "u", em.mesh.num_vertices(), true);
                 std::vector<double> f(em.dofs());
                 em.op->forces(u.data(), f.data(), false);
                 em.op->build_stiffness(definite);
@@ -489,9 +644,9 @@ PYBIND11_MODULE(edgefem, m) {
             py::arg("u"), py::arg("definite") = false, "Builds the tangent stiffness K at u for multiply().")
         .def(
             "multiply",
-            [](const ElasticModel& em, const InArray& x) {
+            [](const ElasticModel& em, py::handle x_in) {
                 if (!em.have_stiffness) throw InvalidArgument("multiply: call build_stiffness(u) first");
-                require_size(x, em.dofs(), "x");
+                const InArray x = vectors_arg(x_in, "x", em.mesh.num_vertices(), true);
                 py::array_t<double> y({py::ssize_t(em.mesh.num_vertices()), py::ssize_t(3)});
                 em.op->multiply(x.data(), y.mutable_data());
                 return y;
@@ -508,8 +663,8 @@ PYBIND11_MODULE(edgefem, m) {
             "The 3x3 diagonal blocks of K, shape (#V, 3, 3).")
         .def(
             "inverted_tets",
-            [](const ElasticModel& em, const InArray& u) {
-                require_size(u, em.dofs(), "u");
+            [](const ElasticModel& em, py::handle u_in) {
+                const InArray u = vectors_arg(u_in, "u", em.mesh.num_vertices(), true);
                 return em.op->inverted_tets(u.data());
             },
             py::arg("u"));

@@ -270,8 +270,6 @@ int main(void) {
                  "missing mesh file");
     expect_error(edgefem_scene_create_from_json("/nonexistent/scene.json", &bad), EDGEFEM_ERROR_FILE, NULL,
                  "missing scene file");
-    expect_error(edgefem_scene_set_integrator(scene, (edgefem_integrator)42), EDGEFEM_ERROR_INVALID_ARGUMENT,
-                 "integrator", "unknown integrator");
     expect_error(edgefem_scene_set_newmark(scene, 0.7, 0.5), EDGEFEM_ERROR_INVALID_ARGUMENT, "newmark.beta",
                  "Newmark beta above 1/2");
     expect_error(edgefem_scene_set_generalized_alpha(scene, -0.1), EDGEFEM_ERROR_INVALID_ARGUMENT,
@@ -286,12 +284,52 @@ int main(void) {
     CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_BDF2_LINEAR));
     CHECK_OK(edgefem_scene_set_generalized_alpha(scene, 0.5));
     CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_SEMI_IMPLICIT));
+    /* Enumerations are integers, range-checked and named (issue #27). */
+    expect_error(edgefem_scene_set_integrator(scene, 42), EDGEFEM_ERROR_INVALID_ARGUMENT, "integrator: 42",
+                 "integrator 42");
+    expect_error(edgefem_scene_set_integrator(scene, -1), EDGEFEM_ERROR_INVALID_ARGUMENT, "integrator: -1",
+                 "integrator -1");
+    expect_error(edgefem_scene_set_model(scene, -3), EDGEFEM_ERROR_INVALID_ARGUMENT, "model: -3", "model -3");
+    expect_error(edgefem_scene_set_model(scene, 2), EDGEFEM_ERROR_INVALID_ARGUMENT, "model: 2", "model 2");
     /* One vector: the message names the component, not a "vertex". */
     expect_error(edgefem_scene_set_gravity(scene, 0, NAN, 0), EDGEFEM_ERROR_INVALID_ARGUMENT, "gravity[1] is not finite",
                  "NaN gravity");
     CHECK(strstr(edgefem_last_error(), "vertex") == NULL);
     expect_error(edgefem_sim_set_external_force(sim, 2, 0, NAN, 0), EDGEFEM_ERROR_INVALID_ARGUMENT,
                  "force on vertex 2 is not finite", "NaN force on one vertex");
+
+    /* Mesh arrays out, and prescribed vertices (issue #26's "complete C API"). */
+    {
+        int32_t* tets_out = malloc(sizeof(int32_t) * 4 * (size_t)nt);
+        CHECK_OK(edgefem_scene_get_tets(scene, tets_out, 4 * (size_t)nt));
+        CHECK(memcmp(tets_out, T, sizeof(int32_t) * 4 * (size_t)nt) == 0);
+        expect_error(edgefem_scene_get_tets(scene, tets_out, 4 * (size_t)nt - 1), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                     "4 x #T", "short tets buffer");
+        free(tets_out);
+        edgefem_scene* pres = NULL;
+        CHECK_OK(edgefem_scene_create_box(4, 2, 2, 0.01, &pres));
+        const int32_t clamp[] = {0, 5, 10, 15};                     /* x = min end of the 5 x 3 x 3 grid */
+        CHECK_OK(edgefem_scene_set_fixed(pres, clamp, 4));
+        const int32_t tip = 4 + 5 * (2 + 3 * 2);                    /* (i, j, k) = (4, 2, 2) */
+        double rest[3 * 45];
+        CHECK_OK(edgefem_scene_get_rest_positions(pres, rest, 3 * 45));
+        const double target[3] = {rest[3 * tip], rest[3 * tip + 1], rest[3 * tip + 2] - 0.005};
+        expect_error(edgefem_scene_set_prescribed(pres, clamp, target, 1, 1), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                     "also fixed", "prescribed vertex also fixed");
+        expect_error(edgefem_scene_set_prescribed(pres, &tip, target, 1, 0), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                     "steps", "prescribed over 0 steps");
+        CHECK_OK(edgefem_scene_set_prescribed(pres, &tip, target, 1, 1));
+        edgefem_sim* ps = NULL;
+        CHECK_OK(edgefem_sim_create(pres, &ps));
+        int32_t converged = 0;
+        CHECK_OK(edgefem_sim_solve_static(ps, &converged));
+        double xs[3 * 45];
+        CHECK_OK(edgefem_sim_get_positions(ps, xs, 3 * 45));
+        CHECK(converged == 1);
+        CHECK(fabs(xs[3 * tip + 2] - target[2]) < 1e-12 && fabs(xs[3 * clamp[1] + 2] - rest[3 * clamp[1] + 2]) == 0);
+        edgefem_sim_destroy(ps);
+        edgefem_scene_destroy(pres);
+    }
 
     /* An explicit step far beyond the stability limit fails as a simulation error. */
     edgefem_scene* stiff = NULL;
@@ -329,6 +367,14 @@ int main(void) {
     edgefem_scene_destroy(scene);
     edgefem_scene_destroy(NULL);
     edgefem_sim_destroy(NULL);
+    /* Destroying twice, or what no create returned, does nothing. */
+    edgefem_sim_destroy(sim);
+    edgefem_scene_destroy(scene);
+    {
+        double not_a_handle[8] = {0};
+        edgefem_sim_destroy((edgefem_sim*)not_a_handle);
+        edgefem_scene_destroy((edgefem_scene*)not_a_handle);
+    }
     free(f);
     free(u);
     free(x);

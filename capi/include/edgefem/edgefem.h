@@ -12,7 +12,21 @@
  *
  * Vectors are xyz-interleaved doubles, 3 per vertex; vertex and tet indices
  * are 0-based int32. Buffer sizes are passed as counts of doubles (or
- * indices) and checked.
+ * indices) and checked. Enumerations are passed as int32_t and
+ * range-checked (EDGEFEM_ERROR_INVALID_ARGUMENT naming the argument).
+ *
+ * Handles: destroying NULL, or a handle already destroyed, does nothing.
+ * Any other use of a destroyed handle cannot be detected and is undefined
+ * behaviour (as after free()); set your pointer to NULL after destroying it.
+ * (A handle destroyed twice with another created in between may have been
+ * given the same address: the second destroy then frees the new one.)
+ *
+ * Threads: distinct handles may be used from distinct threads at once. One
+ * simulation is used by one thread at a time: a step, static solve or
+ * energies call while another thread is inside one of those on the same
+ * simulation fails with EDGEFEM_ERROR_INVALID_ARGUMENT instead of racing
+ * (other overlapping calls are not detected). edgefem_last_error() is per
+ * thread.
  *
  * @code
  * edgefem_scene* scene = NULL;
@@ -133,7 +147,8 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_json(const char* path,
  *  the origin; vertex (i, j, k) has index i + (nx+1) (j + (ny+1) k). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_box(int32_t nx, int32_t ny, int32_t nz, double cell,
                                                          edgefem_scene** out);
-/** Frees a scene (NULL is ignored). Simulations created from it stay valid. */
+/** Frees a scene (NULL, or a scene already destroyed, is ignored).
+ *  Simulations created from it stay valid. */
 EDGEFEM_C_EXPORT void edgefem_scene_destroy(edgefem_scene* scene);
 
 /** Number of vertices and tets. */
@@ -142,6 +157,9 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_counts(const edgefem_scene* scene,
 /** Copies the rest positions (count = 3 x num_vertices). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_rest_positions(const edgefem_scene* scene, double* out,
                                                                  size_t count);
+/** Copies the tets: 4 vertex indices per tet (count = 4 x num_tets), as
+ *  validated (every tet positively oriented). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_tets(const edgefem_scene* scene, int32_t* out, size_t count);
 /** One material for the whole mesh: Young's modulus (Pa), Poisson ratio in
  *  (-1, 0.5), density (kg/m^3). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_material(edgefem_scene* scene, double young, double poisson,
@@ -149,12 +167,21 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_material(edgefem_scene* scene,
 /** Replaces the fixed vertices (held at rest); count 0 frees all. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_fixed(edgefem_scene* scene, const int32_t* vertices,
                                                         size_t count);
+/** Replaces the prescribed vertices: vertices[i] is driven to the position
+ *  targets[3 i .. 3 i + 2] (m), moved linearly from rest over `steps` (>= 1)
+ *  time steps and held there; a static solve reaches the targets fully.
+ *  count 0 clears them. A vertex out of range, prescribed twice or also
+ *  fixed, or a non-finite target, is EDGEFEM_ERROR_INVALID_ARGUMENT and
+ *  leaves the scene unchanged. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_prescribed(edgefem_scene* scene, const int32_t* vertices,
+                                                             const double* targets, size_t count, int32_t steps);
 /** Gravity (m/s^2). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_gravity(edgefem_scene* scene, double gx, double gy, double gz);
 /** Time step (s, finite and > 0). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_dt(edgefem_scene* scene, double dt);
-/** Integrator. */
-EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, edgefem_integrator integrator);
+/** Integrator: an ::edgefem_integrator value; any other integer is
+ *  EDGEFEM_ERROR_INVALID_ARGUMENT. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_integrator(edgefem_scene* scene, int32_t integrator);
 /** Newmark's beta in (0, 1/2] and gamma in [1/2, 1] (defaults 1/4, 1/2). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_newmark(edgefem_scene* scene, double beta, double gamma);
 /** Generalized-alpha's spectral radius at infinite frequency rho_inf in [0, 1] (default 0.8). */
@@ -172,8 +199,9 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_prescribed_keyframes(edgefem_s
  *  keyframes (times, values, key_count; 0 keys: constant). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_load(edgefem_scene* scene, const double* load, size_t count,
                                                        const double* times, const double* values, size_t key_count);
-/** Elastic model (FE or SN). */
-EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_model(edgefem_scene* scene, edgefem_model model);
+/** Elastic model: an ::edgefem_model value (FE or SN); any other integer is
+ *  EDGEFEM_ERROR_INVALID_ARGUMENT. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_model(edgefem_scene* scene, int32_t model);
 /** Rayleigh damping D = alpha M + beta K. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_damping(edgefem_scene* scene, double alpha, double beta);
 /** CG settings: relative tolerance, iteration cap, and a fixed budget
@@ -217,7 +245,7 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_sim_create(const edgefem_scene* scene, e
  *  EDGEFEM_ERROR_INVALID_ARGUMENT with a message naming it. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_sim_create_with(const edgefem_scene* scene, const edgefem_run_options* run,
                                                         edgefem_sim** out);
-/** Frees a simulation (NULL is ignored). */
+/** Frees a simulation (NULL, or a simulation already destroyed, is ignored). */
 EDGEFEM_C_EXPORT void edgefem_sim_destroy(edgefem_sim* sim);
 
 /** Number of vertices. */

@@ -9,6 +9,7 @@
 #include "edgefem/core/inverted_tets.hpp"
 #include "edgefem/core/operator_blocks.hpp"
 #include "edgefem/core/tet_model.hpp"
+#include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/physics/edge_blocks.hpp"
 #include "edgefem/physics/edge_force.hpp"
 #include "edgefem/physics/edge_g.hpp"
@@ -223,6 +224,7 @@ private:
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_reference_operator(const Mesh& mesh, const Materials& materials,
                                                             ModelKind model, Method method) {
+    check_mesh_indices(mesh);
     if (method == Method::Tet) {
         if (model == ModelKind::SN) throw InvalidArgument("the spring-network model exists only for the edge method");
         return std::make_unique<ReferenceTetOperator<S>>(mesh, materials);

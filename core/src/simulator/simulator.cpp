@@ -6,6 +6,8 @@
 
 #include <utility>
 
+#include "edgefem/core/finite_input.hpp"
+#include "edgefem/core/in_use_flag.hpp"
 #include "integrators/static_solve.hpp"
 #include "simulator/host_views.hpp"
 #include "integrators/time_integrator.hpp"
@@ -20,6 +22,7 @@ struct Simulator<S>::Impl {
     std::unique_ptr<sim::TimeIntegrator<S>> integrator;
     sim::StepControl<S> control;
     sim::HostViews<S> views;
+    InUseFlag in_use;
 
     Impl(Scene scene, std::shared_ptr<const Backend<S>> backend)
         : state(std::move(scene), std::move(backend)),
@@ -29,11 +32,28 @@ struct Simulator<S>::Impl {
         if (!integrator->builds_stiffness()) state.op->keep_state(false);
     }
 
-    // Runs `call` on the state: the written views synced in first, the
-    // views' copies stale after (also when it throws).
+    // The state and loads the application may have written: finite, or the
+    // call is refused naming them (before anything changes). The back-end's
+    // reduction first; the host copies only to name a bad value.
+    void check_inputs() const {
+        const std::size_t n = state.n();
+        if (state.kernels.first_non_finite(state.u.data(), state.v.data(), n) == n &&
+            state.kernels.first_non_finite(state.fext.data(), state.fext.data(), n) == n)
+            return;
+        std::vector<S> copy;
+        require_finite_vectors(state.u.read_host(copy), "displacement");
+        require_finite_vectors(state.v.read_host(copy), "velocity");
+        require_finite_vectors(state.fext.read_host(copy), "external_forces");
+    }
+
+    // Runs `call` on the state, one thread at a time (`name` the public
+    // call): the written views synced in and checked first, the views'
+    // copies stale after (also when it throws).
     template <class Call>
-    decltype(auto) on_state(Call&& call) {
+    decltype(auto) on_state(const char* name, Call&& call) {
+        const InUseFlag::Claim claim(in_use, name);
         views.sync();
+        check_inputs();
         struct Changed {
             const sim::HostViews<S>& v;
             ~Changed() { v.changed(); }
@@ -42,7 +62,9 @@ struct Simulator<S>::Impl {
     }
 
     Energies energies() {
+        const InUseFlag::Claim claim(in_use, "energies");
         views.sync();
+        check_inputs();
         const auto& s = state;
         Energies e;
         e.elastic = s.op->energy(s.u.data());
@@ -86,13 +108,13 @@ index_t Simulator<S>::num_vertices() const {
 template <class S>
 const StepStats& Simulator<S>::step() {
     Impl& m = self();
-    return m.on_state([&]() -> const StepStats& { return m.control.step(); });
+    return m.on_state("step", [&]() -> const StepStats& { return m.control.step(); });
 }
 template <class S>
 StaticResult Simulator<S>::solve_static() {
     Impl& m = self();
     try {
-        return m.on_state([&] { return sim::solve_static(m.state, m.solve); });
+        return m.on_state("solve_static", [&] { return sim::solve_static(m.state, m.solve); });
     } catch (const sim::StepFailure& failure) {
         throw SimulationError("static solve: " + failure.message, self().state.step, failure.vertex);
     }

@@ -5,6 +5,7 @@
 #include "edgefem/core/inverted_tets.hpp"
 #include "edgefem/core/operator_blocks.hpp"
 #include "edgefem/core/tet_model.hpp"
+#include "edgefem/core/validate_mesh.hpp"
 #include "cpu/edge_kernels.hpp"
 #include "cpu/parallel_edge_kernels.hpp"
 #include "cpu/parallel_tet_kernels.hpp"
@@ -283,6 +284,7 @@ private:
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_cpu_operator(const Mesh& mesh, const Materials& materials, ModelKind model,
                                                       Method method, const CpuOptions& options, const PlanOptions& plan) {
+    check_mesh_indices(mesh);
     if (method == Method::Tet && model == ModelKind::SN)
         throw InvalidArgument("the spring-network model exists only for the edge method");
     if (!options.executor && options.variant == Variant::Auto) {  // the serial loops

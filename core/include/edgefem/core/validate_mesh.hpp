@@ -46,4 +46,11 @@ ValidationReport validate_mesh(Mesh& mesh, const ValidationOptions& options = {}
 // (the Simulator rejects them: a vertex without mass).
 void check_mesh(const Mesh& mesh, const ValidationOptions& options = {});
 
+// The checks without which a kernel would read or write outside its arrays:
+// array sizes, every index in [0, #V), four distinct vertices per tet.
+// MeshError naming the tet. O(#T); every operator factory and write_vtu run
+// it, so a mesh that skipped validation fails there with a clear error
+// instead of corrupting memory.
+void check_mesh_indices(const Mesh& mesh);
+
 }  // namespace edgefem

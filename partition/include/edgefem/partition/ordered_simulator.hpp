@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "edgefem/core/in_use_flag.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/partition/ordering.hpp"
 
@@ -68,7 +69,8 @@ private:
     std::span<S> view(std::vector<S>& mirror, std::span<S> (Simulator<S>::*get)()) {
         return identity() ? (sim_.*get)() : std::span<S>(mirror);
     }
-    // The user's views into the internal state (push) and back (pull).
+    // The user's views into the internal state (push, after checking that
+    // they are finite) and back (pull).
     void push();
     void pull();
 
@@ -77,6 +79,7 @@ private:
     Simulator<S> sim_;
     std::vector<S> u_, v_, fext_, f_;  // the user-numbered views (empty for the identity)
     std::vector<double> mass_;
+    InUseFlag in_use_;  // step, solve_static and energies: one thread at a time
 };
 
 extern template class OrderedSimulator<double>;
