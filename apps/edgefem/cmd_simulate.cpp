@@ -24,6 +24,7 @@ struct SimulateOptions {
     std::string scene;  // empty: the built-in default
     std::string out;    // overrides output.dir
     int steps = -1;     // >= 0 overrides the scene's steps
+    std::string preconditioner;  // non-empty overrides solver.preconditioner
     // Its ordering is the internal vertex numbering: RCM by default (the
     // force on bunny-1m runs 2-2.5x faster than in TetGen's numbering:
     // docs/layouts.md, "Orderings: bunny-1m force, 1 thread"); frames and
@@ -79,6 +80,8 @@ void run_simulate(const SimulateOptions& opts) {
     SceneFile sf = load_scene_file(opts.scene);
     if (!opts.out.empty()) sf.output.dir = opts.out;
     if (opts.steps >= 0) sf.scene.steps = opts.steps;
+    if (!opts.preconditioner.empty())
+        sf.scene.solver.preconditioner = parse_preconditioner(opts.preconditioner, "--preconditioner");
     const OutputSettings out = sf.output;
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
@@ -192,6 +195,9 @@ void add_simulate_command(CLI::App& app) {
         ->check(non_empty_path());
     cmd->add_option("--steps", opts->steps, "Number of steps (overrides the scene's steps)")
         ->check(int_in_range(0));
+    cmd->add_option("--preconditioner", opts->preconditioner,
+                    "CG's preconditioner: block-jacobi or amg (overrides the scene's solver.preconditioner; "
+                    "docs/solvers.md)");
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->run.ordering);
     add_run_options(*cmd, opts->run);

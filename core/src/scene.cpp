@@ -31,6 +31,14 @@ const char* to_string(Integrator i) {
 
 const char* to_string(LinearSolver s) { return s == LinearSolver::CG ? "cg" : "direct"; }
 
+const char* to_string(PreconditionerKind p) { return p == PreconditionerKind::Amg ? "amg" : "block-jacobi"; }
+
+PreconditionerKind parse_preconditioner(const std::string& name, const std::string& key) {
+    if (name == "block-jacobi") return PreconditionerKind::BlockJacobi;
+    if (name == "amg") return PreconditionerKind::Amg;
+    throw InvalidArgument(key + ": expected one of \"block-jacobi\", \"amg\", got \"" + name + "\"");
+}
+
 void Scene::validate() const {
     const index_t nv = mesh.num_vertices();
     if (mesh.num_tets() == 0) bad("mesh", "the mesh has no tets");
@@ -58,6 +66,8 @@ void Scene::validate() const {
         bad("integrator", "not an integrator (explicit, semi-implicit or implicit)");
     if (solver.linear_solver != LinearSolver::CG && solver.linear_solver != LinearSolver::Direct)
         bad("solver.linear_solver", "not a linear solver (cg or direct)");
+    if (solver.preconditioner != PreconditionerKind::BlockJacobi && solver.preconditioner != PreconditionerKind::Amg)
+        bad("solver.preconditioner", "not a preconditioner (block-jacobi or amg)");
     materials.validate();
     for (int r = 0; r < 3; ++r)
         if (!std::isfinite(gravity[r])) bad("gravity", "non-finite component");

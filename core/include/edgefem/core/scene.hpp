@@ -22,12 +22,19 @@ enum class Integrator {
 };
 
 enum class LinearSolver {
-    CG,      // matrix-free CG on the per-edge K, block-Jacobi preconditioned
-    Direct,  // assembled sparse K, Eigen's SimplicialLDLT
+    CG,      // matrix-free CG on the per-edge K (SolverSettings::preconditioner)
+    Direct,  // assembled sparse K, CHOLMOD (supernodal LL^T, LDL^T when A is indefinite)
+};
+
+// CG's preconditioner (docs/solvers.md says when each is faster).
+enum class PreconditionerKind {
+    BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap, iterations grow with dt, stiffness and mesh size
+    Amg,          // smoothed-aggregation multigrid on the rigid-body modes: set-up per K, few iterations
 };
 
 struct SolverSettings {
     LinearSolver linear_solver = LinearSolver::CG;
+    PreconditionerKind preconditioner = PreconditionerKind::BlockJacobi;
     double cg_tolerance = 1e-6;   // relative residual |r| / |b| of the projected system
     int cg_max_iterations = 500;
     int cg_fixed_iterations = 0;  // > 0: exactly this many warm-started iterations (haptic budget)
@@ -93,5 +100,9 @@ struct Scene {
 
 const char* to_string(Integrator i);
 const char* to_string(LinearSolver s);
+const char* to_string(PreconditionerKind p);  // "block-jacobi", "amg"
+// The kind named `name` ("block-jacobi" or "amg"); InvalidArgument naming
+// `key` and the accepted names otherwise.
+PreconditionerKind parse_preconditioner(const std::string& name, const std::string& key = "solver.preconditioner");
 
 }  // namespace edgefem
