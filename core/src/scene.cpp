@@ -68,6 +68,7 @@ void Scene::validate() const {
         bad("solver.linear_solver", "not a linear solver (cg or direct)");
     if (solver.preconditioner != PreconditionerKind::BlockJacobi && solver.preconditioner != PreconditionerKind::Amg)
         bad("solver.preconditioner", "not a preconditioner (block-jacobi or amg)");
+    if (solver.amg_refresh_interval < 0) bad("solver.amg_refresh_interval", "must be >= 0 (0: adaptive)");
     materials.validate();
     for (int r = 0; r < 3; ++r)
         if (!std::isfinite(gravity[r])) bad("gravity", "non-finite component");

@@ -32,6 +32,13 @@ struct SparseCholesky::Impl {
         cholmod_start(&c);
         c.print = 0;             // status checked here, nothing on stderr
         c.quick_return_if_not_posdef = true;
+        // The fill-reducing ordering: AMD and METIS nested dissection tried,
+        // the one with the least fill kept (on the built-in beam METIS: 12 %
+        // fewer flops, docs/solvers.md); the analysis runs once per pattern.
+        c.nmethods = 2;
+        c.method[0].ordering = CHOLMOD_AMD;
+        c.method[1].ordering = CHOLMOD_METIS;
+        c.postorder = true;
     }
     ~Impl() {
         if (ll.L) cholmod_free_factor(&ll.L, &c);

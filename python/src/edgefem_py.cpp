@@ -260,6 +260,7 @@ PYBIND11_MODULE(edgefem, m) {
             "preconditioner", [](const SolverSettings& s) { return std::string(to_string(s.preconditioner)); },
             [](SolverSettings& s, const std::string& name) { s.preconditioner = parse_preconditioner(name); },
             "CG's preconditioner: \"block-jacobi\" or \"amg\" (docs/solvers.md)")
+        .def_readwrite("amg_refresh_interval", &SolverSettings::amg_refresh_interval)
         .def_readwrite("cg_tolerance", &SolverSettings::cg_tolerance)
         .def_readwrite("cg_max_iterations", &SolverSettings::cg_max_iterations)
         .def_readwrite("cg_fixed_iterations", &SolverSettings::cg_fixed_iterations)

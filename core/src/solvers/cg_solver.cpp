@@ -27,6 +27,7 @@ public:
         const CgResult res = s_.kernels.cg(A, *precond_, s_.free_dof.data(), b.data(), x.data(), s_.n(),
                                            {tolerance, s_.scene.solver.cg_max_iterations, fixed_iterations}, work_);
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, false);
+        precond_->solved(res.iterations);
         return res;
     }
 

@@ -14,6 +14,9 @@ template <class S>
 class Preconditioner : public CgPreconditioner {
 public:
     virtual void setup(LinearSystem<S>& A) = 0;
+    // The iterations of the solve it just preconditioned (a lagged set-up
+    // decides from them when to refresh).
+    virtual void solved(int /*iterations*/) {}
     // Bytes it holds (the memory figures of docs/solvers.md).
     virtual std::size_t bytes() const = 0;
 };

@@ -35,6 +35,12 @@ enum class PreconditionerKind {
 struct SolverSettings {
     LinearSolver linear_solver = LinearSolver::CG;
     PreconditionerKind preconditioner = PreconditionerKind::BlockJacobi;
+    // AMG: when its Galerkin operators and smoothers follow a new K (the
+    // fine level's products are always the current K's). 0 (default): lagged
+    // while CG's iterations stay within 1.5x (+ 2) of those right after the
+    // last refresh, and on every change of the step size; N >= 1: every N-th
+    // K (1: every K). docs/solvers.md has the measurements.
+    int amg_refresh_interval = 0;
     double cg_tolerance = 1e-6;   // relative residual |r| / |b| of the projected system
     int cg_max_iterations = 500;
     int cg_fixed_iterations = 0;  // > 0: exactly this many warm-started iterations (haptic budget)

@@ -23,7 +23,7 @@ namespace edgefem {
 using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 struct AmgSettings {
-    int max_coarse_dofs = 3000;  // the coarsest level is factorised once it has at most this many dofs
+    int max_coarse_dofs = 250;   // the coarsest level is factorised (densely filled) once it has at most this many dofs
     int max_levels = 8;
     int smoothing_steps = 1;     // l1 block-Jacobi sweeps before and after the coarse correction
     int power_iterations = 12;   // for the prolongator smoother's spectral radius
