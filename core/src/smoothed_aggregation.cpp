@@ -78,17 +78,35 @@ void thin_qr(const std::vector<double>& B, std::size_t rows, std::vector<double>
 }
 
 // The block graph of A (nodes of `bs` dofs): the nodes j != i with a
-// stored entry in node i's rows.
-std::vector<std::vector<index_t>> node_graph(const SparseRows& A, int bs) {
+// stored entry in node i's rows and, when theta > 0, a strong coupling:
+// |A_ij|_F^2 > theta^2 |A_ii|_F |A_jj|_F (the coarse levels' Galerkin
+// operators couple every pair of nearby aggregates, mostly weakly).
+std::vector<std::vector<index_t>> node_graph(const SparseRows& A, int bs, double theta) {
     const index_t nodes = index_t(A.rows() / bs);
+    std::vector<double> diag(std::size_t(nodes), 0.0);
+    for (index_t i = 0; i < nodes; ++i)
+        for (int r = 0; r < bs; ++r)
+            for (SparseRows::InnerIterator it(A, i * bs + r); it; ++it)
+                if (it.col() / bs == i) diag[std::size_t(i)] += it.value() * it.value();
     std::vector<std::vector<index_t>> adj{std::size_t(nodes)};
+    std::vector<double> w(std::size_t(nodes), 0.0);
     for (index_t i = 0; i < nodes; ++i) {
         auto& a = adj[std::size_t(i)];
         for (int r = 0; r < bs; ++r)
-            for (SparseRows::InnerIterator it(A, i * bs + r); it; ++it)
-                if (it.col() / bs != i) a.push_back(index_t(it.col() / bs));
+            for (SparseRows::InnerIterator it(A, i * bs + r); it; ++it) {
+                const index_t j = index_t(it.col() / bs);
+                if (j == i) continue;
+                if (w[std::size_t(j)] == 0) a.push_back(j);
+                w[std::size_t(j)] += it.value() * it.value() + 1e-300;
+            }
         std::sort(a.begin(), a.end());
-        a.erase(std::unique(a.begin(), a.end()), a.end());
+        std::size_t kept = 0;
+        for (index_t j : a) {
+            const double dd = std::sqrt(diag[std::size_t(i)]) * std::sqrt(diag[std::size_t(j)]);
+            if (theta == 0 || w[std::size_t(j)] > theta * theta * dd) a[kept++] = j;
+            w[std::size_t(j)] = 0;
+        }
+        a.resize(kept);
     }
     return adj;
 }
@@ -332,7 +350,9 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         const int bs = L.bs;
         if (Al.rows() <= settings.max_coarse_dofs || int(m.level.size()) >= settings.max_levels) break;
         index_t count = 0;
-        const std::vector<index_t> agg = aggregate(node_graph(Al, bs), count);
+        // The finest level aggregates on the whole edge graph; coarser ones
+        // on their strong couplings only.
+        const std::vector<index_t> agg = aggregate(node_graph(Al, bs, m.level.size() == 1 ? 0.0 : 0.08), count);
         if (Eigen::Index(count) * kModes >= Al.rows()) break;  // no coarsening left
         // Tentative prolongator: per aggregate, B's rows = Q R (thin QR).
         std::vector<std::vector<index_t>> members{std::size_t(count)};
