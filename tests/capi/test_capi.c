@@ -250,7 +250,7 @@ int main(void) {
     expect_error(edgefem_scene_set_dt(scene, -1e-3), EDGEFEM_ERROR_INVALID_ARGUMENT, "dt", "negative dt");
     expect_error(edgefem_scene_set_preconditioner(scene, "multigrid"), EDGEFEM_ERROR_INVALID_ARGUMENT,
                  "solver.preconditioner", "unknown preconditioner");
-    expect_error(edgefem_scene_set_preconditioner(scene, NULL), EDGEFEM_ERROR_INVALID_ARGUMENT, "name",
+    expect_error(edgefem_scene_set_preconditioner(scene, NULL), EDGEFEM_ERROR_NULL_POINTER, "name",
                  "null preconditioner name");
     expect_error(edgefem_scene_set_dt(scene, NAN), EDGEFEM_ERROR_INVALID_ARGUMENT, "dt", "NaN dt");
     expect_error(edgefem_scene_set_material(scene, 1e5, 0.5, 1000), EDGEFEM_ERROR_INVALID_ARGUMENT, NULL,
