@@ -8,6 +8,8 @@ packages=(
   libeigen3-dev       # dense 3x3 algebra in set-up code
   libtbb-dev          # TBB back-end
   libmetis-dev        # partitioning / reordering
+  libsuitesparse-dev  # CHOLMOD: the direct solver
+  libhypre-dev        # benchmarks: hypre BoomerAMG, the AMG preconditioner's comparison
   libgtest-dev        # tests
   libbenchmark-dev    # benchmarks
   libcli11-dev        # command-line parsing

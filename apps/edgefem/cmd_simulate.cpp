@@ -26,6 +26,7 @@ struct SimulateOptions {
     std::string out;    // overrides output.dir
     int steps = -1;     // >= 0 overrides the scene's steps
     std::string integrator;  // non-empty overrides the scene's integrator
+    std::string preconditioner;  // non-empty overrides solver.preconditioner
     // Its ordering is the internal vertex numbering: RCM by default (the
     // force on bunny-1m runs 2-2.5x faster than in TetGen's numbering:
     // docs/layouts.md, "Orderings: bunny-1m force, 1 thread"); frames and
@@ -90,6 +91,8 @@ void run_simulate(const SimulateOptions& opts) {
             if (opts.integrator == name) sf.scene.integrator = value;
         sf.scene.validate();  // settings the new integrator does not take are errors
     }
+    if (!opts.preconditioner.empty())
+        sf.scene.solver.preconditioner = parse_preconditioner(opts.preconditioner, "--preconditioner");
     const OutputSettings out = sf.output;
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
@@ -226,6 +229,9 @@ void add_simulate_command(CLI::App& app) {
     for (const auto& [name, value] : integrator_names()) integrators.push_back(name);
     cmd->add_option("--integrator", opts->integrator, "Time integrator (overrides the scene's; docs/dynamics.md)")
         ->check(CLI::IsMember(integrators));
+    cmd->add_option("--preconditioner", opts->preconditioner,
+                    "CG's preconditioner: block-jacobi or amg (overrides the scene's solver.preconditioner; "
+                    "docs/solvers.md)");
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->run.ordering);
     add_run_options(*cmd, opts->run);

@@ -459,6 +459,14 @@ edgefem_status edgefem_scene_set_cg(edgefem_scene* scene, double tolerance, int3
     });
 }
 
+edgefem_status edgefem_scene_set_preconditioner(edgefem_scene* scene, const char* name) {
+    return guard("edgefem_scene_set_preconditioner", [&] {
+        require(scene, "scene");
+        require(name, "name");
+        scene->scene.solver.preconditioner = edgefem::parse_preconditioner(name);
+    });
+}
+
 // ---- Simulations ----
 
 void edgefem_run_options_default(edgefem_run_options* out) {

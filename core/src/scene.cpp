@@ -80,6 +80,14 @@ void check_per_dof(const std::string& field, const std::vector<double>& x, std::
 }
 }  // namespace
 
+const char* to_string(PreconditionerKind p) { return p == PreconditionerKind::Amg ? "amg" : "block-jacobi"; }
+
+PreconditionerKind parse_preconditioner(const std::string& name, const std::string& key) {
+    if (name == "block-jacobi") return PreconditionerKind::BlockJacobi;
+    if (name == "amg") return PreconditionerKind::Amg;
+    throw InvalidArgument(key + ": expected one of \"block-jacobi\", \"amg\", got \"" + name + "\"");
+}
+
 void Scene::validate() const {
     const index_t nv = mesh.num_vertices();
     if (mesh.num_tets() == 0) bad("mesh", "the mesh has no tets");
@@ -115,6 +123,9 @@ void Scene::validate() const {
         bad("generalized_alpha.rho_inf", "must lie in [0, 1], got " + std::to_string(ip.rho_inf));
     if (solver.linear_solver != LinearSolver::CG && solver.linear_solver != LinearSolver::Direct)
         bad("solver.linear_solver", "not a linear solver (cg or direct)");
+    if (solver.preconditioner != PreconditionerKind::BlockJacobi && solver.preconditioner != PreconditionerKind::Amg)
+        bad("solver.preconditioner", "not a preconditioner (block-jacobi or amg)");
+    if (solver.amg_refresh_interval < 0) bad("solver.amg_refresh_interval", "must be >= 0 (0: adaptive)");
     materials.validate();
     for (int r = 0; r < 3; ++r)
         if (!std::isfinite(gravity[r])) bad("gravity", "non-finite component");

@@ -406,6 +406,11 @@ PYBIND11_MODULE(_edgefem, m) {
     py::class_<SolverSettings>(m, "SolverSettings")
         .def(py::init<>())
         .def_readwrite("linear_solver", &SolverSettings::linear_solver)
+        .def_property(
+            "preconditioner", [](const SolverSettings& s) { return std::string(to_string(s.preconditioner)); },
+            [](SolverSettings& s, const std::string& name) { s.preconditioner = parse_preconditioner(name); },
+            "CG's preconditioner: \"block-jacobi\" or \"amg\" (docs/solvers.md)")
+        .def_readwrite("amg_refresh_interval", &SolverSettings::amg_refresh_interval)
         .def_readwrite("cg_tolerance", &SolverSettings::cg_tolerance)
         .def_readwrite("cg_max_iterations", &SolverSettings::cg_max_iterations)
         .def_readwrite("cg_fixed_iterations", &SolverSettings::cg_fixed_iterations)
@@ -505,6 +510,7 @@ PYBIND11_MODULE(_edgefem, m) {
         .def_readonly("stiffness_ms", &StepStats::stiffness_ms)
         .def_readonly("solve_ms", &StepStats::solve_ms)
         .def_readonly("solver_iterations", &StepStats::solver_iterations)
+        .def_readonly("symbolic_analyses", &StepStats::symbolic_analyses)
         .def_readonly("newton_iterations", &StepStats::newton_iterations)
         .def_readonly("residual", &StepStats::residual)
         .def_readonly("negative_curvature", &StepStats::negative_curvature)

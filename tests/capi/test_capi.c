@@ -119,6 +119,7 @@ int main(void) {
     CHECK_OK(edgefem_scene_set_dt(scene, 1e-3));
     CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_SEMI_IMPLICIT));
     CHECK_OK(edgefem_scene_set_cg(scene, 1e-6, 500, 0));
+    CHECK_OK(edgefem_scene_set_preconditioner(scene, "block-jacobi"));
 
     edgefem_sim* sim = NULL;
     CHECK_OK(edgefem_sim_create(scene, &sim));
@@ -247,6 +248,10 @@ int main(void) {
                  "index out of range");
     T[4 * 5 + 2] = saved;
     expect_error(edgefem_scene_set_dt(scene, -1e-3), EDGEFEM_ERROR_INVALID_ARGUMENT, "dt", "negative dt");
+    expect_error(edgefem_scene_set_preconditioner(scene, "multigrid"), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                 "solver.preconditioner", "unknown preconditioner");
+    expect_error(edgefem_scene_set_preconditioner(scene, NULL), EDGEFEM_ERROR_NULL_POINTER, "name",
+                 "null preconditioner name");
     expect_error(edgefem_scene_set_dt(scene, NAN), EDGEFEM_ERROR_INVALID_ARGUMENT, "dt", "NaN dt");
     expect_error(edgefem_scene_set_material(scene, 1e5, 0.5, 1000), EDGEFEM_ERROR_INVALID_ARGUMENT, NULL,
                  "Poisson 0.5");

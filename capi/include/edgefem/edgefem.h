@@ -209,6 +209,10 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_damping(edgefem_scene* scene, 
  *  solve, the real-time setting; 0: iterate to the tolerance). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_cg(edgefem_scene* scene, double tolerance,
                                                      int32_t max_iterations, int32_t fixed_iterations);
+/** CG's preconditioner by name: "block-jacobi" or "amg" (docs/solvers.md);
+ *  another name is EDGEFEM_ERROR_INVALID_ARGUMENT naming
+ *  "solver.preconditioner". */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_preconditioner(edgefem_scene* scene, const char* name);
 
 /* ---- Simulations ------------------------------------------------------- */
 

@@ -21,7 +21,7 @@ public:
             *this->launch_.ex, n, free_dof, [&](const double* in, double* out) { A.products(in, out); },
             [&](std::size_t lo, std::size_t hi, const double* in, double* out) { A.finish(lo, hi, in, out); },
             [&](std::size_t lo, std::size_t hi, const double* r, double* z) { M.apply(lo, hi, r, z); }, b, x,
-            settings.tolerance, settings.max_iterations, settings.fixed_iterations, work);
+            settings.tolerance, settings.max_iterations, settings.fixed_iterations, work, M.whole_vector());
     }
 };
 

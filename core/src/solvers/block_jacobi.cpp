@@ -13,7 +13,7 @@ public:
         : s_(state), D_(state.template vector<S>(state.n() * 3)), D0_(state.template vector<S>(0)),
           Dinv_(state.template vector<double>(3 * state.n() + 1)) {}  // + 1: the last 4-lane row read (apply)
 
-    void setup(const LinearSystem<S>& A) override {
+    void setup(LinearSystem<S>& A) override {
         A.K().diagonal_blocks(D_.data());
         if (A.c_b() != 0) {
             D0_.resize(D_.size());
@@ -22,6 +22,8 @@ public:
         s_.kernels.block_jacobi_build(Dinv_.data(), D_.data(), D0_.data(), s_.mass.data(), A.c_m(), A.c_k(), A.c_b(),
                                       s_.n());
     }
+
+    std::size_t bytes() const override { return sizeof(double) * Dinv_.size() + sizeof(S) * (D_.size() + D0_.size()); }
 
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override {
         s_.kernels.block_jacobi_apply_range(lo, hi, Dinv_.data(), r, z);

@@ -1,5 +1,5 @@
-// Matrix-free CG (the back-end's cg kernel) on the per-edge K with a
-// block-Jacobi preconditioner; right-hand sides of extreme magnitude are
+// Matrix-free CG (the back-end's cg kernel) on the per-edge K with the
+// scene's preconditioner; right-hand sides of extreme magnitude are
 // scaled by a power of two first.
 #include <algorithm>
 #include <cmath>
@@ -15,7 +15,7 @@ template <class S>
 class CgSolver final : public SystemSolver<S> {
 public:
     explicit CgSolver(const SimState<S>& state)
-        : s_(state), precond_(make_block_jacobi(state)), work_(state.backend->memory()) {}
+        : s_(state), precond_(make_preconditioner(state)), work_(state.backend->memory()) {}
 
     bool reusable() const override { return true; }
     void setup(LinearSystem<S>& A) override { precond_->setup(A); }
@@ -27,6 +27,7 @@ public:
         const CgResult res = s_.kernels.cg(A, *precond_, s_.free_dof.data(), b.data(), x.data(), s_.n(),
                                            {tolerance, s_.scene.solver.cg_max_iterations, fixed_iterations}, work_);
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, false);
+        precond_->solved(res.iterations);
         return res;
     }
 

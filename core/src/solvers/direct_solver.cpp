@@ -1,11 +1,12 @@
-// The assembled path: A on the free dofs as an Eigen sparse matrix
-// (sparse_assembly.hpp), factorised by SimplicialLDLT. On the host: b and x
-// through host() (back-ends with host memory).
-#include <Eigen/SparseCholesky>
+// The assembled path: A on the free dofs (SystemMatrix, its pattern found
+// once), factorised by CHOLMOD (SparseCholesky): supernodal LL^T, or LDL^T
+// when A is not positive definite; the symbolic analysis is done once per
+// pattern and reused by every later step and Newton iteration. On the host:
+// b and x through host() (back-ends with host memory).
 #include <cmath>
-#include <utility>
 
-#include "edgefem/core/sparse_assembly.hpp"
+#include "edgefem/core/sparse_cholesky.hpp"
+#include "solvers/system_matrix.hpp"
 #include "solvers/system_solver.hpp"
 
 namespace edgefem::sim {
@@ -15,16 +16,14 @@ namespace {
 template <class S>
 class DirectSolver final : public SystemSolver<S> {
 public:
-    explicit DirectSolver(const SimState<S>& state) : s_(state) {}
+    explicit DirectSolver(const SimState<S>& state) : s_(state), matrix_(state) {}
 
     bool reusable() const override { return false; }
+    int analyses() const override { return chol_.analyses(); }
 
     void setup(LinearSystem<S>& A) override {
-        nf_ = number_free_dofs(s_.free_host, dof_index_);
-        std::vector<std::pair<double, const ElasticOperator<S>*>> terms{{A.c_k(), &A.K()}};
-        if (A.c_b() != 0) terms.emplace_back(A.c_b(), A.K0());
-        matrix_ = assemble_system(dof_index_, nf_, A.c_m(), s_.mass_host, terms);
-        ldlt_.compute(matrix_);
+        matrix_.assemble(A);
+        factored_ = matrix_.lower_free().n == 0 || chol_.factor(matrix_.lower_free());
     }
 
     CgResult solve(LinearSystem<S>& A, BackendVector<double>& b_vec, BackendVector<double>& x_vec, double,
@@ -34,31 +33,37 @@ public:
         const std::span<const double> b = b_vec.host();
         const std::span<double> x = x_vec.host();
         const auto& free_dof = s_.free_host;
+        const LowerCsc& L = matrix_.lower_free();
+        if (!factored_) {
+            res.residual = INFINITY;
+            return res;
+        }
         // rhs = b - A x_constrained
         BackendVector<double> xc_vec = s_.template vector<double>(n), Ac_vec = s_.template vector<double>(n);
         const std::span<double> xc = xc_vec.host(), Ac = Ac_vec.host();
         for (std::size_t i = 0; i < n; ++i) xc[i] = free_dof[i] ? 0.0 : x[i];
         A.apply(xc.data(), Ac.data());
-        Eigen::VectorXd rhs(nf_);
+        std::vector<double> rhs, sol(std::size_t(L.n));
         for (std::size_t i = 0; i < n; ++i)
-            if (dof_index_[i] >= 0) rhs[dof_index_[i]] = b[i] - Ac[i];
-        if (ldlt_.info() != Eigen::Success) {
-            res.residual = INFINITY;
-            return res;
-        }
-        const Eigen::VectorXd sol = ldlt_.solve(rhs);
-        for (std::size_t i = 0; i < n; ++i)
-            if (dof_index_[i] >= 0) x[i] = sol[dof_index_[i]];
-        // Indefinite A: LDLT still solves, but report it like CG would.
-        const auto D = ldlt_.vectorD();
-        res.negative_curvature = (D.array() <= 0).any();
-        // Norms summed by hand: Eigen's reductions trip g++ 12.2's false
-        // -Wmaybe-uninitialized inside its AVX-512 code (GCC PR 105593).
-        const Eigen::VectorXd r = matrix_ * sol - rhs;
+            if (free_dof[i]) rhs.push_back(b[i] - Ac[i]);
+        if (L.n > 0) chol_.solve(rhs.data(), sol.data());
+        for (std::size_t i = 0, j = 0; i < n; ++i)
+            if (free_dof[i]) x[i] = sol[j++];
+        // Indefinite A: LDL^T still solves, but report it like CG would.
+        res.negative_curvature = chol_.used_ldlt() && chol_.indefinite();
+        // |A sol - rhs| / |rhs| with the lower triangle (symmetric A).
+        std::vector<double> r(rhs.size());
+        for (std::size_t j = 0; j < r.size(); ++j) r[j] = -rhs[j];
+        for (index_t j = 0; j < L.n; ++j)
+            for (index_t e = L.col_start[std::size_t(j)]; e < L.col_start[std::size_t(j) + 1]; ++e) {
+                const auto i = std::size_t(L.row[std::size_t(e)]);
+                r[i] += L.value[std::size_t(e)] * sol[std::size_t(j)];
+                if (i != std::size_t(j)) r[std::size_t(j)] += L.value[std::size_t(e)] * sol[i];
+            }
         double rr = 0, bb = 0;
-        for (Eigen::Index i = 0; i < r.size(); ++i) {
-            rr += r[i] * r[i];
-            bb += rhs[i] * rhs[i];
+        for (std::size_t j = 0; j < r.size(); ++j) {
+            rr += r[j] * r[j];
+            bb += rhs[j] * rhs[j];
         }
         res.residual = std::sqrt(rr) / std::max(std::sqrt(bb), 1e-300);
         res.converged = std::isfinite(res.residual) && !res.negative_curvature;
@@ -67,10 +72,9 @@ public:
 
 private:
     const SimState<S>& s_;
-    std::vector<index_t> dof_index_;
-    index_t nf_ = 0;
-    Eigen::SparseMatrix<double> matrix_;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+    SystemMatrix<S> matrix_;
+    SparseCholesky chol_;
+    bool factored_ = false;
 };
 
 }  // namespace

@@ -1,5 +1,7 @@
 // A preconditioner for CG on a LinearSystem: set up after K was built,
-// then applied range by range inside the cg kernel's passes.
+// then applied range by range inside the cg kernel's passes (or, for a
+// whole-vector one, once per iteration between them).
+// One implementation per SolverSettings::preconditioner, each in its file.
 #pragma once
 
 #include <memory>
@@ -11,11 +13,21 @@ namespace edgefem::sim {
 template <class S>
 class Preconditioner : public CgPreconditioner {
 public:
-    virtual void setup(const LinearSystem<S>& A) = 0;
+    virtual void setup(LinearSystem<S>& A) = 0;
+    // The iterations of the solve it just preconditioned (a lagged set-up
+    // decides from them when to refresh).
+    virtual void solved(int /*iterations*/) {}
+    // Bytes it holds (the memory figures of docs/solvers.md).
+    virtual std::size_t bytes() const = 0;
 };
 
-// Block-Jacobi (block_jacobi.cpp).
+// The scene's SolverSettings::preconditioner.
 template <class S>
-std::unique_ptr<Preconditioner<S>> make_block_jacobi(const SimState<S>& state);
+std::unique_ptr<Preconditioner<S>> make_preconditioner(const SimState<S>& state);
+
+template <class S>
+std::unique_ptr<Preconditioner<S>> make_block_jacobi(const SimState<S>& state);  // block_jacobi.cpp
+template <class S>
+std::unique_ptr<Preconditioner<S>> make_amg(const SimState<S>& state);           // amg_preconditioner.cpp
 
 }  // namespace edgefem::sim

@@ -16,6 +16,8 @@ public:
     // Whether a set-up may serve later solves (a lagged K,
     // SolverSettings::stiffness_interval).
     virtual bool reusable() const = 0;
+    // Symbolic analyses done so far (the direct solver's; 0 for CG).
+    virtual int analyses() const { return 0; }
     // For A with its K just built (preconditioner, factorisation).
     virtual void setup(LinearSystem<S>& A) = 0;
     // x holds a warm start; `fixed_iterations` > 0: exactly that many

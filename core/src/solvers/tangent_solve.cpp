@@ -28,7 +28,9 @@ CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const E
     system_.set(c_m, c_k, c_b, K0);
     if (!reuse_stiffness) {
         s_.op->build_stiffness(definite);
+        const int analyses = solver_->analyses();
         solver_->setup(system_);
+        s_.stats.symbolic_analyses += solver_->analyses() - analyses;
     }
     s_.stats.stiffness_ms += ms_since(t0);
     t0 = Clock::now();

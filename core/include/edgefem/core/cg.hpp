@@ -55,11 +55,15 @@ public:
 };
 
 // z = M^-1 r on [lo, hi) from r on [lo, hi) only, on the calling thread;
-// lo and hi are multiples of 3 (whole vertices) or n.
+// lo and hi are multiples of 3 (whole vertices) or n. A whole-vector
+// preconditioner (a multigrid cycle) needs all of r: it is applied once
+// per iteration as apply(0, n, r, z), between the cg kernel's passes, and
+// may run its own parallel loops.
 class CgPreconditioner {
 public:
     virtual ~CgPreconditioner() = default;
     virtual void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const = 0;
+    virtual bool whole_vector() const { return false; }
 };
 
 // CG's scalar steps. bnorm: |P(b - A x_c)|, the norm residuals are
@@ -123,7 +127,10 @@ CgResult cg_iterations(const CgControl& c, double rr, double rz, Iterate&& itera
 // overwrites z = M^-1 r on [lo, hi) from r on [lo, hi) only. Block bounds
 // are multiples of kVectorBlock (a multiple of 3: whole vertices) or n.
 // `fixed_iterations` > 0 runs exactly that many iterations (unless the
-// residual vanishes), ignoring the tolerance.
+// residual vanishes), ignoring the tolerance. `whole_M`: apply_M needs the
+// whole vector (CgPreconditioner::whole_vector): it is called as
+// apply_M(0, n, r, z) once per iteration between two parallel regions (the
+// three phases become phases 0-1, M, then r.z and p's update).
 //
 // Between two products an iteration is one pass of three phases over the
 // blocks, one parallel region with two barriers: (0) finish A p, partials
@@ -136,7 +143,7 @@ CgResult cg_iterations(const CgControl& c, double rr, double rz, Iterate&& itera
 template <class ApplyA, class FinishA, class ApplyM>
 CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_t* free_dof, ApplyA&& apply_A,
                             FinishA&& finish_A, ApplyM&& apply_M, const double* b, double* x, double tolerance,
-                            int max_iterations, int fixed_iterations, CgWork& w) {
+                            int max_iterations, int fixed_iterations, CgWork& w, bool whole_M = false) {
     w.r.resize(n);
     w.z.resize(n);
     w.p.resize(n);
@@ -208,17 +215,38 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
             for (std::size_t i = lo; i < hi; ++i) r[i] = (b[i] - Ap[i]) * keep[i];
             bb_part[k] = block_sum(lo, hi, [=](std::size_t i) { return b[i] * b[i] * keep[i]; });
             rr_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * r[i]; });
+            if (whole_M) return;
             apply_M(lo, hi, r, z);
             for (std::size_t i = lo; i < hi; ++i) p[i] = z[i] * keep[i];
             rz_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * p[i]; });
         });
     });
+    // r.z of the updated r and z (a whole-vector M's second region).
+    const auto rz_sums = [&](std::size_t lo, std::size_t hi, std::size_t k) {
+        rz_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * z[i] * keep[i]; });
+    };
+    if (whole_M) {
+        apply_M(0, n, r, z);
+        ex.for_uniform_phases(1, phase_first, [&](int, index_t g) {
+            blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
+                for (std::size_t i = lo; i < hi; ++i) p[i] = z[i] * keep[i];
+                rz_sums(lo, hi, k);
+            });
+        });
+    }
     if (!moving_constraints) bnorm = std::sqrt(total(bb_part));
     const CgControl control({tolerance, max_iterations, fixed_iterations}, bnorm);
     return cg_iterations(control, total(rr_part), total(rz_part), [&](double rz) {
+        const auto update_p = [&](index_t g) {
+            if (control.converged(control.residual(total(rr_part)))) return;
+            const double beta = CgControl::beta(total(rz_part), rz);
+            blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t) {
+                for (std::size_t i = lo; i < hi; ++i) p[i] = (z[i] + beta * p[i]) * keep[i];
+            });
+        };
         apply_A(p, Ap);
         // Each group sums the partials it needs once, in a fixed order (partials_total).
-        ex.for_uniform_phases(3, phase_first, [&, rz](int phase, index_t g) {
+        ex.for_uniform_phases(whole_M ? 2 : 3, phase_first, [&, rz](int phase, index_t g) {
             if (phase == 0) {
                 blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t k) {
                     finish_A(lo, hi, p, Ap);
@@ -236,17 +264,22 @@ CgResult conjugate_gradient(const Executor& ex, std::size_t n, const std::uint8_
                         r[i] = (r[i] - alpha * Ap[i]) * keep[i];
                     }
                     rr_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * r[i]; });
+                    if (whole_M) return;
                     apply_M(lo, hi, r, z);
-                    rz_part[k] = block_sum(lo, hi, [=](std::size_t i) { return r[i] * z[i] * keep[i]; });
+                    rz_sums(lo, hi, k);
                 });
                 return;
             }
-            if (control.converged(control.residual(total(rr_part)))) return;
-            const double beta = CgControl::beta(total(rz_part), rz);
-            blocks(g, [&](std::size_t lo, std::size_t hi, std::size_t) {
-                for (std::size_t i = lo; i < hi; ++i) p[i] = (z[i] + beta * p[i]) * keep[i];
-            });
+            update_p(g);
         });
+        if (whole_M && CgControl::positive_curvature(total(pap_part)) &&
+            !control.converged(control.residual(total(rr_part)))) {
+            apply_M(0, n, r, z);
+            ex.for_uniform_phases(2, phase_first, [&](int phase, index_t g) {
+                if (phase == 0) blocks(g, rz_sums);
+                else update_p(g);
+            });
+        }
         return CgSums{total(pap_part), total(rr_part), total(rz_part)};
     });
 }

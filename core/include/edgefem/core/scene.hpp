@@ -48,12 +48,25 @@ struct IntegratorParameters {
 };
 
 enum class LinearSolver {
-    CG,      // matrix-free CG on the per-edge K, block-Jacobi preconditioned
-    Direct,  // assembled sparse K, Eigen's SimplicialLDLT
+    CG,      // matrix-free CG on the per-edge K (SolverSettings::preconditioner)
+    Direct,  // assembled sparse K, CHOLMOD (supernodal LL^T, LDL^T when A is indefinite)
+};
+
+// CG's preconditioner (docs/solvers.md says when each is faster).
+enum class PreconditionerKind {
+    BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap, iterations grow with dt, stiffness and mesh size
+    Amg,          // smoothed-aggregation multigrid on the rigid-body modes: set-up per K, few iterations
 };
 
 struct SolverSettings {
     LinearSolver linear_solver = LinearSolver::CG;
+    PreconditionerKind preconditioner = PreconditionerKind::BlockJacobi;
+    // AMG: when its Galerkin operators and smoothers follow a new K (the
+    // fine level's products are always the current K's). 0 (default): lagged
+    // while CG's iterations stay within 1.5x (+ 2) of those right after the
+    // last refresh, and on every change of the step size; N >= 1: every N-th
+    // K (1: every K). docs/solvers.md has the measurements.
+    int amg_refresh_interval = 0;
     double cg_tolerance = 1e-6;   // relative residual |r| / |b| of the projected system
     int cg_max_iterations = 500;
     int cg_fixed_iterations = 0;  // > 0: exactly this many warm-started iterations (haptic budget)
@@ -145,5 +158,9 @@ const char* to_string(Integrator i);
 // Every integrator with its name (scene JSON, CLI, Python), in enum order.
 const std::vector<std::pair<const char*, Integrator>>& integrator_names();
 const char* to_string(LinearSolver s);
+const char* to_string(PreconditionerKind p);  // "block-jacobi", "amg"
+// The kind named `name` ("block-jacobi" or "amg"); InvalidArgument naming
+// `key` and the accepted names otherwise.
+PreconditionerKind parse_preconditioner(const std::string& name, const std::string& key = "solver.preconditioner");
 
 }  // namespace edgefem

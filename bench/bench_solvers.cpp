@@ -1,0 +1,494 @@
+// The linear solvers compared on one machine in one run (docs/solvers.md):
+//  direct  the built-in beam's system (12,000 dofs): the old factorisation
+//          (Eigen SimplicialLDLT, analysis + factorisation every step, as
+//          direct_solver.cpp did before CHOLMOD) against CHOLMOD's (the
+//          analysis once, then the numeric factorisation), alternating rounds;
+//          the whole per-step set-up of each path (K, assembly, factorisation)
+//  step    semi-implicit steps with CG to 1e-6, block-Jacobi against AMG,
+//          alternating steps of two simulators: ms per step, CG iterations,
+//          set-up (K and the preconditioner), the AMG's first (building) step
+//  matrix  one assembled system A = M + dt^2 K per mesh and dt, solved to 1e-6
+//          from zero by PCG with block-Jacobi, with edgefem's smoothed
+//          aggregation (fine level assembled here) and with hypre's
+//          BoomerAMG (systems AMG, 3 functions, nodal coarsening) on the same
+//          matrix; memory of each preconditioner against the per-edge K's.
+// Medians over rounds; serial (one thread). Usage:
+//   edgefem_bench_solvers [--meshes beam,bunny-4k] [--dts 1,4,10] [--rounds 9] [--quick]
+#include <HYPRE.h>
+#include <HYPRE_parcsr_ls.h>
+#include <mpi.h>
+
+#include <Eigen/LU>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bench_meshes.hpp"
+#include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/scene_json.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/core/smoothed_aggregation.hpp"
+#include "edgefem/core/sparse_assembly.hpp"
+#include "edgefem/core/sparse_cholesky.hpp"
+#include "edgefem/parallel/cpu_backend.hpp"
+#include "lab/benchmark_scene.hpp"
+
+using namespace edgefem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// Plain loops: Eigen's dense reductions trip g++ 12's false
+// -Wmaybe-uninitialized with AVX-512 (GCC PR 105593).
+double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    double s = 0;
+    for (Eigen::Index i = 0; i < a.size(); ++i) s += a[i] * b[i];
+    return s;
+}
+double norm(const Eigen::VectorXd& a) { return std::sqrt(dot(a, a)); }
+
+double median(std::vector<double> v) {
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Scene named_scene(const std::string& name) {
+    if (name == "beam") return default_scene();
+    Scene s = step_benchmark_scene(bench::bench_mesh(name), Material{1e5, 0.3, 1000});
+    return s;
+}
+
+void for_solve(Scene& s, double dt_ms, PreconditionerKind pc) {
+    s.dt = dt_ms * 1e-3;
+    s.solver.cg_fixed_iterations = 0;
+    s.solver.cg_tolerance = 1e-6;
+    s.solver.cg_max_iterations = 20000;
+    s.solver.preconditioner = pc;
+    s.count_inverted_tets = false;
+}
+
+// The system of a semi-implicit step at the state `u`: A = M + dt^2 K on the
+// free dofs (dof: the free numbering) or on all dofs (constrained rows and
+// columns zero).
+struct Assembled {
+    std::vector<index_t> dof;
+    Eigen::SparseMatrix<double> A;
+    std::vector<std::uint8_t> free;
+    std::vector<double> mass;
+    double k_ms = 0, assembly_ms = 0;
+};
+
+Assembled assemble_at(const Scene& s, ElasticOperator<double>& op, const std::vector<double>& u, bool all_dofs) {
+    Assembled a;
+    const std::size_t n = s.mesh.X.size();
+    a.free.assign(n, 1);
+    for (index_t v : s.fixed)
+        for (int c = 0; c < 3; ++c) a.free[3 * std::size_t(v) + std::size_t(c)] = 0;
+    std::vector<double> f(n);
+    op.forces(u.data(), f.data(), false);
+    auto t0 = Clock::now();
+    op.build_stiffness(s.solver.definite_stiffness);
+    a.k_ms = ms_since(t0);
+    a.mass = lumped_mass(s.mesh, s.materials);
+    const index_t nf = number_free_dofs(all_dofs ? std::vector<std::uint8_t>(n, 1) : a.free, a.dof);
+    t0 = Clock::now();
+    a.A = assemble_system<double>(a.dof, nf, 1.0, a.mass, {{s.dt * s.dt, &op}});
+    a.assembly_ms = ms_since(t0);
+    if (all_dofs)
+        for (int k = 0; k < a.A.outerSize(); ++k)
+            for (Eigen::SparseMatrix<double>::InnerIterator it(a.A, k); it; ++it)
+                if (!a.free[std::size_t(it.row())] || !a.free[std::size_t(it.col())]) it.valueRef() = 0;
+    return a;
+}
+
+// The displacement after `steps` CG steps of s.
+std::vector<double> state_after(Scene s, int steps) {
+    s.solver.preconditioner = PreconditionerKind::BlockJacobi;
+    Simulator<double> sim(std::move(s), nullptr, cpu_operator_factory<double>());
+    for (int k = 0; k < steps; ++k) sim.step();
+    const auto u = sim.displacement();
+    return {u.begin(), u.end()};
+}
+
+LowerCsc lower_of(const Eigen::SparseMatrix<double>& A) {
+    const Eigen::SparseMatrix<double> L = A.triangularView<Eigen::Lower>();
+    LowerCsc out;
+    out.n = index_t(A.rows());
+    out.col_start.assign(L.outerIndexPtr(), L.outerIndexPtr() + L.cols() + 1);
+    out.row.assign(L.innerIndexPtr(), L.innerIndexPtr() + L.nonZeros());
+    out.value.assign(L.valuePtr(), L.valuePtr() + L.nonZeros());
+    return out;
+}
+
+void bench_direct(int rounds) {
+    Scene s = default_scene();
+    for_solve(s, 1, PreconditionerKind::BlockJacobi);
+    const std::vector<double> u = state_after(s, 5);
+    auto op = cpu_operator_factory<double>()(s.mesh, s.materials, s.model, s.method);
+    Assembled a = assemble_at(s, *op, u, false);
+    std::printf("\n## direct: built-in beam, %ld free dofs, %ld stored entries (A = M + dt^2 K after 5 steps)\n\n",
+                long(a.A.rows()), long(a.A.nonZeros()));
+    SparseCholesky chol;
+    auto t0 = Clock::now();
+    chol.factor(lower_of(a.A));
+    const double first = ms_since(t0);
+    std::vector<double> eig, chm, eig_solve, chm_solve, eig_setup, chm_setup;
+    Eigen::VectorXd b = Eigen::VectorXd::Ones(a.A.rows()), x(a.A.rows());
+    double diff = 0;
+    for (int r = 0; r < rounds; ++r) {
+        // old path, per step: K, triplet assembly, SimplicialLDLT (analysis + factorisation)
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+        t0 = Clock::now();
+        ldlt.compute(a.A);
+        eig.push_back(ms_since(t0));
+        t0 = Clock::now();
+        const Eigen::VectorXd xe = ldlt.solve(b);
+        eig_solve.push_back(ms_since(t0));
+        Assembled again = assemble_at(s, *op, u, false);
+        eig_setup.push_back(again.k_ms + again.assembly_ms + eig.back());
+        // new: the numeric factorisation on the analysis kept
+        const LowerCsc L = lower_of(a.A);
+        t0 = Clock::now();
+        chol.factor(L);
+        chm.push_back(ms_since(t0));
+        t0 = Clock::now();
+        chol.solve(b.data(), x.data());
+        chm_solve.push_back(ms_since(t0));
+        diff = std::max(diff, norm(x - xe) / norm(xe));
+    }
+    // the new path's per-step set-up inside the simulator: K, assembly into the kept pattern, factorisation
+    Scene sd = s;
+    sd.solver.linear_solver = LinearSolver::Direct;
+    Simulator<double> sim(sd, nullptr, cpu_operator_factory<double>());
+    std::vector<double> step_ms, setup_ms;
+    for (int k = 0; k < rounds + 2; ++k) {
+        t0 = Clock::now();
+        const StepStats& st = sim.step();
+        if (k < 2) continue;
+        step_ms.push_back(ms_since(t0));
+        setup_ms.push_back(st.stiffness_ms);
+    }
+    std::printf("| path | factorisation ms | solve ms | set-up per step ms (K + assembly + factorisation) |\n");
+    std::printf("|---|---:|---:|---:|\n");
+    std::printf("| Eigen SimplicialLDLT (old) | %.1f | %.2f | %.1f |\n", median(eig), median(eig_solve), median(eig_setup));
+    std::printf("| CHOLMOD supernodal LL^T, analysis kept (new) | %.2f | %.2f | %.1f |\n", median(chm),
+                median(chm_solve), median(setup_ms));
+    std::printf("\nCHOLMOD's first call (analysis + factorisation): %.1f ms; factor nonzeros %.3g; "
+                "factorisation ratio old / new: %.1fx; set-up ratio: %.1fx; solutions agree to %.1e; "
+                "new direct step (simulator, median): %.1f ms\n",
+                first, chol.factor_nonzeros(), median(eig) / median(chm), median(eig_setup) / median(setup_ms), diff,
+                median(step_ms));
+}
+
+void bench_steps(const std::vector<std::string>& meshes, const std::vector<double>& dts, int rounds) {
+    std::printf("\n## step: semi-implicit, CG to 1e-6, serial; medians of %d alternating steps (after one)\n\n"
+                "AMG: its Galerkin operators refreshed at every K (`amg_refresh_interval` 1) or lagged (0, the "
+                "default: refreshed when the iterations grow 1.5x).\n\n", rounds);
+    std::printf("| mesh | dofs | dt ms | BJ its | AMG its (every K / lagged) | BJ ms/step | AMG ms/step (every K / lagged) | "
+                "lagged AMG / BJ | BJ set-up ms | AMG set-up ms (every K / lagged) | AMG first step ms |\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (const std::string& m : meshes)
+        for (double dt : dts) {
+            Scene s = named_scene(m);
+            Scene sb = s, sa = s, sl = s;
+            for_solve(sb, dt, PreconditionerKind::BlockJacobi);
+            for_solve(sa, dt, PreconditionerKind::Amg);
+            for_solve(sl, dt, PreconditionerKind::Amg);
+            sa.solver.amg_refresh_interval = 1;
+            sl.solver.amg_refresh_interval = 0;
+            Simulator<double> bj(sb, nullptr, cpu_operator_factory<double>());
+            Simulator<double> amg(sa, nullptr, cpu_operator_factory<double>());
+            Simulator<double> lag(sl, nullptr, cpu_operator_factory<double>());
+            bj.step();
+            lag.step();
+            auto t0 = Clock::now();
+            amg.step();
+            const double first = ms_since(t0);
+            std::vector<double> ms[3], its[3], setup[3];
+            for (int r = 0; r < rounds; ++r)
+                for (int k = 0; k < 3; ++k) {
+                    Simulator<double>& sim = k == 0 ? bj : k == 1 ? amg : lag;
+                    t0 = Clock::now();
+                    const StepStats& st = sim.step();
+                    ms[k].push_back(ms_since(t0));
+                    its[k].push_back(st.solver_iterations);
+                    setup[k].push_back(st.stiffness_ms);
+                }
+            std::printf("| %s | %zu | %g | %.0f | %.0f / %.0f | %.2f | %.2f / %.2f | %.2f | %.2f | %.2f / %.2f | %.1f |\n",
+                        m.c_str(), s.mesh.X.size(), dt, median(its[0]), median(its[1]), median(its[2]), median(ms[0]),
+                        median(ms[1]), median(ms[2]), median(ms[2]) / median(ms[0]), median(setup[0]), median(setup[1]),
+                        median(setup[2]), first);
+            std::fflush(stdout);
+        }
+}
+
+// PCG on an assembled matrix (free dofs where `keep` is 1), from zero, to
+// `tol` relative residual; M: z = M^-1 r.
+int pcg(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, Eigen::VectorXd& x, double tol,
+        const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& M) {
+    x.setZero(b.size());
+    Eigen::VectorXd r = b, z(b.size()), p, Ap;
+    M(r, z);
+    p = z;
+    double rz = dot(r, z);
+    const double bn = norm(b);
+    for (int it = 1; it <= 20000; ++it) {
+        Ap = A * p;
+        const double alpha = rz / dot(p, Ap);
+        x += alpha * p;
+        r -= alpha * Ap;
+        if (norm(r) <= tol * bn) return it;
+        M(r, z);
+        const double rz2 = dot(r, z);
+        p = z + (rz2 / rz) * p;
+        rz = rz2;
+    }
+    return -1;
+}
+
+struct HypreResult {
+    int iterations = 0;
+    double setup_ms = 0, solve_ms = 0, residual = 0;
+};
+
+// hypre BoomerAMG-preconditioned PCG on A (free dofs), systems AMG with 3
+// functions (unknown approach) and nodal coarsening.
+HypreResult hypre_solve(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const Eigen::VectorXd& b,
+                        Eigen::VectorXd& x) {
+    const int n = int(A.rows());
+    HYPRE_IJMatrix ij;
+    HYPRE_IJMatrixCreate(MPI_COMM_WORLD, 0, n - 1, 0, n - 1, &ij);
+    HYPRE_IJMatrixSetObjectType(ij, HYPRE_PARCSR);
+    HYPRE_IJMatrixInitialize(ij);
+    for (int i = 0; i < n; ++i) {
+        std::vector<HYPRE_Int> cols;
+        std::vector<double> vals;
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(A, i); it; ++it) {
+            cols.push_back(HYPRE_Int(it.col()));
+            vals.push_back(it.value());
+        }
+        HYPRE_Int nc = HYPRE_Int(cols.size()), row = i;
+        HYPRE_IJMatrixSetValues(ij, 1, &nc, &row, cols.data(), vals.data());
+    }
+    HYPRE_IJMatrixAssemble(ij);
+    HYPRE_ParCSRMatrix par;
+    HYPRE_IJMatrixGetObject(ij, reinterpret_cast<void**>(&par));
+    const auto vec = [&](const double* v, HYPRE_IJVector& iv) {
+        HYPRE_IJVectorCreate(MPI_COMM_WORLD, 0, n - 1, &iv);
+        HYPRE_IJVectorSetObjectType(iv, HYPRE_PARCSR);
+        HYPRE_IJVectorInitialize(iv);
+        std::vector<HYPRE_Int> idx(static_cast<std::size_t>(n));
+        for (int i = 0; i < n; ++i) idx[std::size_t(i)] = i;
+        HYPRE_IJVectorSetValues(iv, n, idx.data(), v);
+        HYPRE_IJVectorAssemble(iv);
+    };
+    HYPRE_IJVector ib, ix;
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+    vec(b.data(), ib);
+    vec(zero.data(), ix);
+    HYPRE_ParVector pb, px;
+    HYPRE_IJVectorGetObject(ib, reinterpret_cast<void**>(&pb));
+    HYPRE_IJVectorGetObject(ix, reinterpret_cast<void**>(&px));
+    HYPRE_Solver solver, amg;
+    HYPRE_ParCSRPCGCreate(MPI_COMM_WORLD, &solver);
+    HYPRE_PCGSetTol(solver, 1e-6);
+    HYPRE_PCGSetMaxIter(solver, 20000);
+    HYPRE_PCGSetTwoNorm(solver, 1);
+    HYPRE_BoomerAMGCreate(&amg);
+    HYPRE_BoomerAMGSetNumFunctions(amg, 3);
+    HYPRE_BoomerAMGSetNodal(amg, 4);
+    HYPRE_BoomerAMGSetStrongThreshold(amg, 0.5);
+    HYPRE_BoomerAMGSetCoarsenType(amg, 10);  // HMIS
+    HYPRE_BoomerAMGSetInterpType(amg, 6);    // extended+i
+    HYPRE_BoomerAMGSetPMaxElmts(amg, 4);
+    HYPRE_BoomerAMGSetRelaxType(amg, 8);     // l1 symmetric Gauss-Seidel
+    HYPRE_BoomerAMGSetMaxIter(amg, 1);
+    HYPRE_BoomerAMGSetTol(amg, 0.0);
+    HYPRE_BoomerAMGSetPrintLevel(amg, 0);
+    HYPRE_PCGSetPrecond(solver, reinterpret_cast<HYPRE_PtrToSolverFcn>(HYPRE_BoomerAMGSolve),
+                        reinterpret_cast<HYPRE_PtrToSolverFcn>(HYPRE_BoomerAMGSetup), amg);
+    HypreResult res;
+    auto t0 = Clock::now();
+    HYPRE_ParCSRPCGSetup(solver, par, pb, px);
+    res.setup_ms = ms_since(t0);
+    t0 = Clock::now();
+    HYPRE_ParCSRPCGSolve(solver, par, pb, px);
+    res.solve_ms = ms_since(t0);
+    HYPRE_Int its = 0;
+    HYPRE_PCGGetNumIterations(solver, &its);
+    res.iterations = int(its);
+    HYPRE_PCGGetFinalRelativeResidualNorm(solver, &res.residual);
+    x.resize(n);
+    std::vector<HYPRE_Int> idx(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) idx[std::size_t(i)] = i;
+    HYPRE_IJVectorGetValues(ix, n, idx.data(), x.data());
+    HYPRE_BoomerAMGDestroy(amg);
+    HYPRE_ParCSRPCGDestroy(solver);
+    HYPRE_IJVectorDestroy(ib);
+    HYPRE_IJVectorDestroy(ix);
+    HYPRE_IJMatrixDestroy(ij);
+    return res;
+}
+
+void bench_matrix(const std::vector<std::string>& meshes, const std::vector<double>& dts, int rounds) {
+    std::printf("\n## matrix: one assembled A = M + dt^2 K (after 3 steps), PCG from 0 to 1e-6, serial; medians of %d\n\n",
+                rounds);
+    std::printf("| mesh | dt ms | preconditioner | its | set-up ms | solve ms | total ms | memory / per-edge K |\n");
+    std::printf("|---|---:|---|---:|---:|---:|---:|---:|\n");
+    for (const std::string& m : meshes)
+        for (double dt : dts) {
+            Scene s = named_scene(m);
+            for_solve(s, dt, PreconditionerKind::BlockJacobi);
+            const std::vector<double> u = state_after(s, 3);
+            auto op = cpu_operator_factory<double>()(s.mesh, s.materials, s.model, s.method);
+            const Assembled all = assemble_at(s, *op, u, true);
+            const SparseRows A = all.A;
+            const std::size_t n = s.mesh.X.size(), nv = n / 3;
+            // the load: gravity on the free dofs
+            Eigen::VectorXd b = Eigen::VectorXd::Zero(Eigen::Index(n));
+            for (std::size_t v = 0; v < nv; ++v)
+                if (all.free[3 * v + 2]) b[Eigen::Index(3 * v + 2)] = -9.81 * all.mass[v] * s.dt;
+            // per-edge K: 9 doubles per edge + 9 per vertex (diagonal)
+            const double blocks = double(A.nonZeros()) / 9.0;  // 2 #E + #V stored 3x3 blocks
+            const double edges = (blocks - double(nv)) / 2;
+            const double k_bytes = 8.0 * 9.0 * (edges + double(nv));
+            // block-Jacobi
+            std::vector<double> its_bj, t_bj, setup_bj;
+            Eigen::VectorXd x;
+            std::vector<Eigen::Matrix3d> Dinv(nv);
+            const auto bj_setup = [&] {
+                for (std::size_t v = 0; v < nv; ++v) {
+                    Eigen::Matrix3d D;
+                    for (int r = 0; r < 3; ++r)
+                        for (int c = 0; c < 3; ++c) {
+                            const bool live = all.free[3 * v + std::size_t(r)] && all.free[3 * v + std::size_t(c)];
+                            D(r, c) = live ? A.coeff(Eigen::Index(3 * v) + r, Eigen::Index(3 * v) + c) : double(r == c);
+                        }
+                    Dinv[v] = D.inverse();
+                }
+            };
+            const auto bj_apply = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+                z.resize(r.size());
+                for (std::size_t v = 0; v < nv; ++v) z.segment<3>(Eigen::Index(3 * v)) = Dinv[v] * r.segment<3>(Eigen::Index(3 * v));
+                for (std::size_t i = 0; i < n; ++i)
+                    if (!all.free[i]) z[Eigen::Index(i)] = 0;
+            };
+            // smoothed aggregation on the same matrix (fine level assembled)
+            SmoothedAggregation sa;
+            std::vector<double> its_sa, t_sa, setup_sa, refresh_sa;
+            const auto fine = [&](const double* in, double* out) {
+                Eigen::Map<Eigen::VectorXd>(out, Eigen::Index(n)) = A * Eigen::Map<const Eigen::VectorXd>(in, Eigen::Index(n));
+            };
+            const auto sa_apply = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+                z.resize(r.size());
+                sa.apply(r.data(), z.data(), fine);
+            };
+            // hypre on the free dofs
+            std::vector<index_t> dof;
+            const index_t nf = number_free_dofs(all.free, dof);
+            Eigen::SparseMatrix<double, Eigen::RowMajor> Af = assemble_system<double>(dof, nf, 1.0, all.mass, {{s.dt * s.dt, op.get()}});
+            Eigen::VectorXd bf(nf);
+            for (std::size_t i = 0; i < n; ++i)
+                if (dof[i] >= 0) bf[dof[i]] = b[Eigen::Index(i)];
+            std::vector<double> its_h, t_h, setup_h;
+            double x_diff = 0;
+            Eigen::VectorXd x_bj, x_sa, x_h;
+            for (int r = 0; r < rounds; ++r) {
+                auto t0 = Clock::now();
+                bj_setup();
+                setup_bj.push_back(ms_since(t0));
+                t0 = Clock::now();
+                its_bj.push_back(pcg(A, b, x_bj, 1e-6, bj_apply));
+                t_bj.push_back(ms_since(t0));
+                t0 = Clock::now();
+                if (r == 0) sa.build(A, s.mesh.X, all.free);
+                else sa.refresh(A);
+                (r == 0 ? setup_sa : refresh_sa).push_back(ms_since(t0));
+                t0 = Clock::now();
+                its_sa.push_back(pcg(A, b, x_sa, 1e-6, sa_apply));
+                t_sa.push_back(ms_since(t0));
+                const HypreResult h = hypre_solve(Af, bf, x_h);
+                its_h.push_back(h.iterations);
+                setup_h.push_back(h.setup_ms);
+                t_h.push_back(h.solve_ms);
+            }
+            double x_max = 0;
+            for (std::size_t i = 0; i < n; ++i) x_max = std::max(x_max, std::abs(x_sa[Eigen::Index(i)]));
+            for (std::size_t i = 0; i < n; ++i)
+                if (dof[i] >= 0) x_diff = std::max(x_diff, std::abs(x_h[dof[i]] - x_sa[Eigen::Index(i)]) / x_max);
+            const double sa_bytes = double(sa.bytes()) + double(A.nonZeros()) * 20.0;  // + the assembled fine A (values, indices, blocks)
+            const double refresh = refresh_sa.empty() ? NAN : median(refresh_sa);
+            std::printf("| %s | %g | block-Jacobi | %.0f | %.2f | %.2f | %.2f | %.2f |\n", m.c_str(), dt, median(its_bj),
+                        median(setup_bj), median(t_bj), median(setup_bj) + median(t_bj), 8.0 * 18 * double(nv) / k_bytes);
+            std::printf("| %s | %g | edgefem SA-AMG (%d levels; build %.1f, refresh) | %.0f | %.2f | %.2f | %.2f | %.2f |\n",
+                        m.c_str(), dt, sa.levels(), setup_sa[0], median(its_sa), refresh, median(t_sa),
+                        refresh + median(t_sa), sa_bytes / k_bytes);
+            std::printf("| %s | %g | hypre BoomerAMG (systems, nodal) | %.0f | %.2f | %.2f | %.2f | - |\n", m.c_str(), dt,
+                        median(its_h), median(setup_h), median(t_h), median(setup_h) + median(t_h));
+            std::printf("|  |  | (hypre and SA solutions differ by %.1e of max) |  |  |  |  |  |\n", x_diff);
+            std::fflush(stdout);
+        }
+}
+
+std::vector<std::string> split(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    for (std::string item; std::getline(ss, item, ',');)
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> meshes{"beam", "bunny-4k"};
+    std::vector<double> dts{1, 4, 10};
+    int rounds = 9;
+    std::string parts = "direct,step,matrix";
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        const auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "edgefem_bench_solvers: %s needs a value\n", a.c_str());
+                std::exit(2);
+            }
+            return argv[++i];
+        };
+        if (a == "--meshes") meshes = split(next());
+        else if (a == "--dts") {
+            dts.clear();
+            for (const std::string& d : split(next())) dts.push_back(std::stod(d));
+        } else if (a == "--rounds") rounds = std::max(1, std::stoi(next()));
+        else if (a == "--parts") parts = next();
+        else if (a == "--quick") {
+            meshes = {"box-1200"};
+            dts = {4};
+            rounds = 1;
+            parts = "step,matrix";
+        } else {
+            std::fprintf(stderr, "edgefem_bench_solvers: unknown argument %s\n", a.c_str());
+            return 2;
+        }
+    }
+    if (parts.find("direct") != std::string::npos) bench_direct(rounds);
+    if (parts.find("step") != std::string::npos) bench_steps(meshes, dts, rounds);
+    if (parts.find("matrix") != std::string::npos) {
+        // MPI (hypre's) only here: its singleton start leaves a helper process running.
+        MPI_Init(&argc, &argv);
+        bench_matrix(meshes, dts, rounds);
+        HYPRE_Finalize();
+        MPI_Finalize();
+    }
+    return 0;
+}

@@ -1,0 +1,66 @@
+// Smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) for
+// elasticity: nodes are 3x3 vertex blocks on the finest level (6x6 on the
+// coarse ones), the near-nullspace is the six rigid-body modes of the rest
+// shape. build() forms the aggregates (greedy, on the matrix's block graph)
+// and the prolongators P = (I - w D^-1 A) P_tent once; refresh() recomputes
+// the Galerkin operators R A P, the l1 block-Jacobi smoothers and the
+// coarsest factorisation (CHOLMOD, its analysis reused) for a new A of the
+// same pattern; apply() runs one symmetric V-cycle, the finest level's
+// products through a caller's function (the matrix-free per-edge K). On the
+// host, serial apart from the caller's product.
+#pragma once
+
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "edgefem/core/mesh.hpp"
+
+namespace edgefem {
+
+using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+
+struct AmgSettings {
+    int max_coarse_dofs = 250;   // the coarsest level is factorised (densely filled) once it has at most this many dofs
+    int max_levels = 8;
+    int smoothing_steps = 1;     // l1 block-Jacobi sweeps before and after the coarse correction
+    int power_iterations = 12;   // for the prolongator smoother's spectral radius
+};
+
+class SmoothedAggregation {
+public:
+    SmoothedAggregation();
+    ~SmoothedAggregation();
+
+    // A: the fine system over 3 #V dofs with the rows and columns of
+    // constrained dofs zero; rest: 3 coordinates per vertex; free_dof: 1 on
+    // unknowns. Builds the hierarchy, then refresh(A).
+    void build(const SparseRows& A, const std::vector<double>& rest, const std::vector<std::uint8_t>& free_dof,
+               const AmgSettings& settings = {});
+    // Galerkin operators, smoothers and coarsest factorisation for a new A
+    // with the pattern build() saw.
+    void refresh(const SparseRows& A);
+    // z = one V-cycle applied to r (n each, zero on constrained dofs);
+    // fine(x, y): y = A x with constrained entries of y zero.
+    void apply(const double* r, double* z, const std::function<void(const double*, double*)>& fine) const;
+
+    int levels() const;                                // including the finest
+    index_t dofs(int level) const;
+    const SparseRows& tentative(int level) const;      // level -> level + 1, before smoothing
+    const SparseRows& prolongator(int level) const;
+    const Eigen::MatrixXd& near_nullspace(int level) const;  // dofs(level) x 6
+    const SparseRows& matrix(int level) const;         // level >= 1 (level 0: the caller's)
+    std::size_t bytes() const;                         // what apply() and refresh() keep
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// The six rigid-body modes of points (3 coordinates each) about their
+// centroid: translations x, y, z, rotations about x, y, z (3 #points x 6).
+Eigen::MatrixXd rigid_body_modes(const std::vector<double>& points);
+
+}  // namespace edgefem

@@ -1,0 +1,84 @@
+// The AMG preconditioner: SmoothedAggregation (smoothed_aggregation.hpp) on
+// A = c_m M + c_k K (+ c_b K0). The hierarchy (aggregates, prolongators) is
+// built at the first set-up from the rest shape and the edge graph and kept;
+// a refresh assembles A into its fixed pattern (SystemMatrix) and recomputes
+// the Galerkin operators, smoothers and the coarsest factorisation: at every
+// amg_refresh_interval-th K, or (0) lagged while CG's iterations stay within
+// 1.5x + 2 of those after the last refresh and the coefficients (the step
+// size) are unchanged. The finest level's products are the LinearSystem's
+// matrix-free ones (the per-edge K on the back-end's executor). A
+// whole-vector preconditioner: one V-cycle per CG iteration. On the host.
+#include <array>
+
+#include "edgefem/core/smoothed_aggregation.hpp"
+#include "solvers/preconditioner.hpp"
+#include "solvers/system_matrix.hpp"
+
+namespace edgefem::sim {
+
+namespace {
+
+template <class S>
+class Amg final : public Preconditioner<S> {
+public:
+    explicit Amg(const SimState<S>& state) : s_(state), matrix_(state) { matrix_.keep(false, true); }
+
+    void setup(LinearSystem<S>& A) override {
+        A_ = &A;
+        const int interval = s_.scene.solver.amg_refresh_interval;
+        const std::array<double, 3> c{A.c_m(), A.c_k(), A.c_b()};
+        ++age_;
+        const bool due = interval > 0 ? age_ >= interval : stale_ || c != c_;
+        if (built_ && !due) return;
+        matrix_.assemble(A);
+        if (!built_) amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host);
+        else amg_.refresh(matrix_.projected());
+        built_ = true;
+        c_ = c;
+        age_ = 0;
+        stale_ = false;
+        fresh_iterations_ = -1;
+    }
+
+    void solved(int iterations) override {
+        if (fresh_iterations_ < 0) fresh_iterations_ = iterations;
+        else if (iterations > 1.5 * fresh_iterations_ + 2) stale_ = true;
+    }
+
+    bool whole_vector() const override { return true; }
+
+    void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override {
+        if (lo != 0 || hi != s_.n()) throw InvalidArgument("AMG preconditioner: applies to the whole vector only");
+        const auto& fr = s_.free_host;
+        amg_.apply(r, z, [&](const double* x, double* y) {
+            A_->apply(x, y);
+            for (std::size_t i = 0; i < fr.size(); ++i)
+                if (!fr[i]) y[i] = 0;
+        });
+    }
+
+    std::size_t bytes() const override { return amg_.bytes() + matrix_.bytes(); }
+
+private:
+    const SimState<S>& s_;
+    SystemMatrix<S> matrix_;
+    SmoothedAggregation amg_;
+    LinearSystem<S>* A_ = nullptr;
+    bool built_ = false;
+    std::array<double, 3> c_{};  // c_m, c_k, c_b at the last refresh
+    int age_ = 0;                // set-ups since the last refresh
+    bool stale_ = false;         // the iterations grew: refresh at the next K
+    int fresh_iterations_ = -1;  // CG's iterations right after the last refresh
+};
+
+}  // namespace
+
+template <class S>
+std::unique_ptr<Preconditioner<S>> make_amg(const SimState<S>& state) {
+    return std::make_unique<Amg<S>>(state);
+}
+
+template std::unique_ptr<Preconditioner<double>> make_amg(const SimState<double>&);
+template std::unique_ptr<Preconditioner<float>> make_amg(const SimState<float>&);
+
+}  // namespace edgefem::sim

@@ -1,0 +1,298 @@
+// The linear solvers: CHOLMOD's factorisation (SparseCholesky) against
+// dense LU, its symbolic analysis reused; smoothed aggregation's hierarchy
+// (the rigid-body modes reproduced by the tentative prolongators and nearly
+// in K's nullspace); AMG-preconditioned CG, block-Jacobi CG and the direct
+// solver reaching the same step to 1e-8; AMG's iterations at a large step;
+// the preconditioner's name checked.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cantilever.hpp"
+#include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/reference_operator.hpp"
+#include "edgefem/core/scene_json.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/core/smoothed_aggregation.hpp"
+#include "edgefem/core/sparse_assembly.hpp"
+#include "edgefem/core/sparse_cholesky.hpp"
+#include "test_meshes.hpp"
+
+using namespace edgefem;
+
+namespace {
+
+// Plain loops throughout: Eigen's dense reductions and products trip g++
+// 12's false -Wmaybe-uninitialized with AVX-512 (GCC PR 105593).
+using Dense = std::vector<std::vector<double>>;
+
+LowerCsc lower_of(const Dense& A) {
+    LowerCsc L;
+    L.n = index_t(A.size());
+    L.col_start.push_back(0);
+    for (std::size_t j = 0; j < A.size(); ++j) {
+        for (std::size_t i = j; i < A.size(); ++i)
+            if (A[i][j] != 0 || i == j) {
+                L.row.push_back(index_t(i));
+                L.value.push_back(A[i][j]);
+            }
+        L.col_start.push_back(index_t(L.row.size()));
+    }
+    return L;
+}
+
+// A symmetric banded test matrix: a shifted 1D Laplacian with a coupling to
+// the dof 3 away (shift < 0 makes it indefinite).
+Dense banded(int n, double shift) {
+    Dense A(std::size_t(n), std::vector<double>(std::size_t(n), 0.0));
+    for (std::size_t i = 0; i < std::size_t(n); ++i) {
+        A[i][i] = 2.5 + shift + 0.01 * double(i);
+        if (i + 1 < std::size_t(n)) A[i][i + 1] = A[i + 1][i] = -1;
+        if (i + 3 < std::size_t(n)) A[i][i + 3] = A[i + 3][i] = 0.2;
+    }
+    return A;
+}
+
+// |A x - b| / |b|, the full matrix A.
+double residual(const Dense& A, const std::vector<double>& x, const std::vector<double>& b) {
+    double rr = 0, bb = 0;
+    for (std::size_t i = 0; i < A.size(); ++i) {
+        double r = -b[i];
+        for (std::size_t j = 0; j < A.size(); ++j) r += A[i][j] * x[j];
+        rr += r * r;
+        bb += b[i] * b[i];
+    }
+    return std::sqrt(rr / bb);
+}
+
+double frobenius(const Eigen::MatrixXd& M) {
+    double s = 0;
+    for (Eigen::Index j = 0; j < M.cols(); ++j)
+        for (Eigen::Index i = 0; i < M.rows(); ++i) s += M(i, j) * M(i, j);
+    return std::sqrt(s);
+}
+
+double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    double s = 0;
+    for (Eigen::Index i = 0; i < a.size(); ++i) s += a[i] * b[i];
+    return s;
+}
+
+double relative(const std::vector<double>& a, const std::vector<double>& b) {
+    double d = 0, s = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        d += (a[i] - b[i]) * (a[i] - b[i]);
+        s += b[i] * b[i];
+    }
+    return std::sqrt(d / s);
+}
+
+}  // namespace
+
+TEST(SparseCholesky, SolvesToRoundOffAndReusesItsAnalysis) {
+    const int n = 60;
+    SparseCholesky chol;
+    std::vector<double> b(static_cast<std::size_t>(n)), x(static_cast<std::size_t>(n));
+    for (std::size_t i = 0; i < b.size(); ++i) b[i] = std::cos(0.3 * double(i));
+    for (double shift : {0.0, 1.0, 7.0}) {  // same pattern: one analysis
+        const Dense A = banded(n, shift);
+        ASSERT_TRUE(chol.factor(lower_of(A)));
+        EXPECT_FALSE(chol.used_ldlt());
+        chol.solve(b.data(), x.data());
+        EXPECT_LT(residual(A, x, b), 1e-13);
+    }
+    EXPECT_EQ(chol.analyses(), 1);
+    // Indefinite: LL^T fails, LDL^T (its own analysis) solves and says so.
+    const Dense A = banded(n, -2.0);
+    ASSERT_TRUE(chol.factor(lower_of(A)));
+    EXPECT_TRUE(chol.used_ldlt());
+    EXPECT_TRUE(chol.indefinite());
+    chol.solve(b.data(), x.data());
+    EXPECT_LT(residual(A, x, b), 1e-11);
+    EXPECT_EQ(chol.analyses(), 2);
+    // A new pattern: analysed again.
+    Dense C = banded(n, 1.0);
+    C[0][5] = C[5][0] = 0.1;
+    ASSERT_TRUE(chol.factor(lower_of(C)));
+    EXPECT_EQ(chol.analyses(), 3);
+}
+
+TEST(SmoothedAggregation, TentativeProlongatorsReproduceTheRigidBodyModes) {
+    const Mesh mesh = make_box(12, 6, 6);
+    auto op = make_reference_operator<double>(mesh, Materials{Material{1e5, 0.3, 1000}}, ModelKind::FE, Method::Edge);
+    std::vector<double> u(mesh.X.size(), 0.0), f(u.size());
+    op->forces(u.data(), f.data(), false);
+    op->build_stiffness(false);
+    const std::size_t n = mesh.X.size();
+    std::vector<index_t> dof;
+    for (int fixed_first : {0, 1}) {
+        SCOPED_TRACE(fixed_first ? "first 10 vertices fixed" : "free body");
+        std::vector<std::uint8_t> free_dof(n, 1);
+        if (fixed_first)
+            for (std::size_t i = 0; i < 30; ++i) free_dof[i] = 0;
+        const index_t nf = number_free_dofs(std::vector<std::uint8_t>(n, 1), dof);
+        const Eigen::SparseMatrix<double> Kfull = assemble_system<double>(dof, nf, 0.0, {}, {{1.0, op.get()}});
+        // The rigid-body modes are K's nullspace at rest (the near-nullspace).
+        const Eigen::MatrixXd B = rigid_body_modes(mesh.X);
+        const Eigen::MatrixXd KB = Kfull * B;
+        double knorm = 0;
+        for (int k = 0; k < Kfull.outerSize(); ++k)
+            for (Eigen::SparseMatrix<double>::InnerIterator it(Kfull, k); it; ++it) knorm += it.value() * it.value();
+        EXPECT_LT(frobenius(KB), 1e-9 * std::sqrt(knorm) * frobenius(B));
+        // The projected system with a mass term, as the simulator's.
+        SparseRows A = Kfull;
+        for (Eigen::Index i = 0; i < A.rows(); ++i) A.coeffRef(i, i) += 50.0;
+        for (int k = 0; k < A.outerSize(); ++k)
+            for (SparseRows::InnerIterator it(A, k); it; ++it)
+                if (!free_dof[std::size_t(it.row())] || !free_dof[std::size_t(it.col())]) it.valueRef() = 0;
+        SmoothedAggregation amg;
+        amg.build(A, mesh.X, free_dof, AmgSettings{100, 8, 1, 12});
+        ASSERT_GE(amg.levels(), 3);
+        for (int l = 0; l + 1 < amg.levels(); ++l) {
+            const Eigen::MatrixXd& Bl = amg.near_nullspace(l);
+            const Eigen::MatrixXd PB = amg.tentative(l) * amg.near_nullspace(l + 1);
+            EXPECT_LT(frobenius(PB - Bl), 1e-10 * frobenius(Bl)) << "level " << l;
+            EXPECT_GT(frobenius(Bl), 0);
+            EXPECT_EQ(amg.prolongator(l).cols(), amg.dofs(l + 1));
+            // Tentative columns orthonormal per aggregate: P^T P = I on the
+            // columns that carry a mode.
+            const Eigen::MatrixXd PtP = Eigen::MatrixXd(SparseRows(amg.tentative(l).transpose()) * amg.tentative(l));
+            for (Eigen::Index c = 0; c < PtP.rows(); ++c)
+                if (PtP(c, c) > 0.5) {
+                    EXPECT_NEAR(PtP(c, c), 1.0, 1e-12);
+                }
+        }
+        // Level 0's modes are the rest shape's rigid motions, zero on fixed dofs.
+        const Eigen::MatrixXd& B0 = amg.near_nullspace(0);
+        for (std::size_t i = 0; i < n; ++i)
+            for (int c = 0; c < 6; ++c)
+                EXPECT_EQ(B0(Eigen::Index(i), c), free_dof[i] ? B(Eigen::Index(i), c) : 0.0);
+        // The V-cycle is a symmetric positive definite operator: x.Mz = z.Mx.
+        const auto fine = [&](const double* x, double* y) {
+            Eigen::Map<Eigen::VectorXd>(y, A.rows()) = A * Eigen::Map<const Eigen::VectorXd>(x, A.rows());
+        };
+        Eigen::VectorXd r1(A.rows()), r2(A.rows()), z1(A.rows()), z2(A.rows());
+        for (Eigen::Index i = 0; i < A.rows(); ++i) {
+            r1[i] = free_dof[std::size_t(i)] ? std::sin(1.0 + i) : 0.0;
+            r2[i] = free_dof[std::size_t(i)] ? std::cos(0.7 * i) : 0.0;
+        }
+        amg.apply(r1.data(), z1.data(), fine);
+        amg.apply(r2.data(), z2.data(), fine);
+        EXPECT_NEAR(dot(r2, z1), dot(r1, z2), 1e-10 * std::abs(dot(r1, z2)));
+        EXPECT_GT(dot(r1, z1), 0);
+    }
+}
+
+namespace {
+
+// Displacement after `steps` steps of `scene` with the given solver.
+std::vector<double> displacement_after(Scene s, LinearSolver ls, PreconditionerKind pc, int steps, int* iterations) {
+    s.solver.linear_solver = ls;
+    s.solver.preconditioner = pc;
+    s.solver.cg_tolerance = 1e-12;
+    s.solver.cg_max_iterations = 20000;
+    Simulator<double> sim(std::move(s));
+    int its = 0;
+    for (int k = 0; k < steps; ++k) its += sim.step().solver_iterations;
+    if (iterations) *iterations = its;
+    const auto u = sim.displacement();
+    return {u.begin(), u.end()};
+}
+
+void expect_same_solutions(const Scene& s, int steps) {
+    int its_bj = 0, its_amg = 0;
+    const auto bj = displacement_after(s, LinearSolver::CG, PreconditionerKind::BlockJacobi, steps, &its_bj);
+    const auto amg = displacement_after(s, LinearSolver::CG, PreconditionerKind::Amg, steps, &its_amg);
+    const auto direct = displacement_after(s, LinearSolver::Direct, PreconditionerKind::BlockJacobi, steps, nullptr);
+    EXPECT_LT(relative(amg, direct), 1e-8);
+    EXPECT_LT(relative(bj, direct), 1e-8);
+    EXPECT_LT(relative(amg, bj), 1e-8);
+    EXPECT_LT(its_amg, its_bj);
+}
+
+}  // namespace
+
+TEST(Solvers, AmgCgBlockJacobiCgAndDirectAgreeOnABox) {
+    Scene s = test::clamped_box_scene(12, 4, 4, 1e5);
+    s.dt = 4e-3;
+    expect_same_solutions(s, 3);
+}
+
+TEST(Solvers, AmgCgBlockJacobiCgAndDirectAgreeOnASharedMesh) {
+    const std::string prefix = test::shared_mesh_prefix("bunny-4k");
+    if (prefix.empty()) GTEST_SKIP() << "no ../shared/meshes/bunny-4k";
+    Scene s;
+    s.mesh = read_mesh(prefix + ".node");
+    s.materials = Material{1e5, 0.3, 1000};
+    s.gravity = {0, 0, -9.81};
+    // The lowest 1 % of the vertices (by z) fixed.
+    std::vector<std::pair<double, index_t>> z;
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v) z.emplace_back(s.mesh.X[3 * std::size_t(v) + 2], v);
+    std::sort(z.begin(), z.end());
+    for (std::size_t k = 0; k < z.size() / 100; ++k) s.fixed.push_back(z[k].second);
+    s.dt = 4e-3;
+    expect_same_solutions(s, 2);
+}
+
+TEST(Solvers, AmgNeedsFarFewerIterationsThanBlockJacobiAtALargeStep) {
+    Scene s = test::clamped_box_scene(24, 6, 6, 1e6);
+    s.dt = 10e-3;
+    s.solver.cg_tolerance = 1e-6;
+    s.solver.cg_max_iterations = 5000;
+    int its[2] = {0, 0};
+    for (int k = 0; k < 2; ++k) {
+        s.solver.preconditioner = k ? PreconditionerKind::Amg : PreconditionerKind::BlockJacobi;
+        Simulator<double> sim(s);
+        for (int i = 0; i < 2; ++i) its[k] += sim.step().solver_iterations;
+    }
+    EXPECT_LT(4 * its[1], its[0]) << "block-Jacobi " << its[0] << ", AMG " << its[1];
+}
+
+TEST(Solvers, DirectSolverAnalysesThePatternOnce) {
+    for (const Integrator in : {Integrator::SemiImplicit, Integrator::Implicit}) {
+        Scene s = test::cantilever_scene(in, 2e-3);
+        s.solver.linear_solver = LinearSolver::Direct;
+        Simulator<double> sim(std::move(s));
+        int analyses = 0, newton = 0;
+        for (int k = 0; k < 5; ++k) {
+            const StepStats st = sim.step();
+            analyses += st.symbolic_analyses;
+            newton += st.newton_iterations;
+            if (k == 0) {
+                EXPECT_EQ(st.symbolic_analyses, 1);
+            }
+        }
+        EXPECT_EQ(analyses, 1) << to_string(in);
+        if (in == Integrator::Implicit) {
+            EXPECT_GT(newton, 5);
+        }
+    }
+}
+
+TEST(Solvers, PreconditionerNamesAreCheckedAndNamed) {
+    EXPECT_EQ(parse_preconditioner("amg"), PreconditionerKind::Amg);
+    EXPECT_EQ(parse_preconditioner("block-jacobi"), PreconditionerKind::BlockJacobi);
+    try {
+        parse_preconditioner("jacobi");
+        FAIL() << "no error";
+    } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("solver.preconditioner"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("\"jacobi\""), std::string::npos) << e.what();
+    }
+    const SceneFile ok = parse_scene(R"({"mesh": "box:2x2x2", "solver": {"preconditioner": "amg"}})", "", "scene.json");
+    EXPECT_EQ(ok.scene.solver.preconditioner, PreconditionerKind::Amg);
+    try {
+        parse_scene(R"({"mesh": "box:2x2x2", "solver": {"preconditioner": "ilu"}})", "", "scene.json");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("solver.preconditioner"), std::string::npos) << e.what();
+    }
+    Scene s = test::cantilever_scene();
+    s.solver.preconditioner = static_cast<PreconditionerKind>(7);
+    try {
+        s.validate();
+        FAIL() << "no error";
+    } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("solver.preconditioner"), std::string::npos) << e.what();
+    }
+}
