@@ -535,6 +535,16 @@ TEST(Backends, DeviceMemoryIsNeverReadOnTheHostInAStep) {
         EXPECT_FALSE(same_bits(sim.positions(), untouched.positions()));
         EXPECT_TRUE(same(sim.forces(), cpu.forces()));
     }
+    // The AMG preconditioner runs on the host: refused by name, not a crash.
+    Scene amg = semi_implicit_scene();
+    amg.solver.preconditioner = PreconditionerKind::Amg;
+    try {
+        Simulator<double> s(amg, device);
+        s.step();
+        ADD_FAILURE() << "AMG ran on device memory";
+    } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("solver.preconditioner"), std::string::npos) << e.what();
+    }
     Scene direct = semi_implicit_scene();
     direct.solver.linear_solver = LinearSolver::Direct;
     Simulator<double> sim(direct, device);

@@ -43,6 +43,24 @@ class Integrator(_Enum):
     Explicit: ClassVar[Integrator]
     SemiImplicit: ClassVar[Integrator]
     Implicit: ClassVar[Integrator]
+    Newmark: ClassVar[Integrator]
+    NewmarkLinear: ClassVar[Integrator]
+    GeneralizedAlpha: ClassVar[Integrator]
+    GeneralizedAlphaLinear: ClassVar[Integrator]
+    Bdf2: ClassVar[Integrator]
+    Bdf2Linear: ClassVar[Integrator]
+    Verlet: ClassVar[Integrator]
+
+class Keyframe:
+    time: float
+    value: float
+    def __init__(self, time: float, value: float) -> None: ...
+
+class IntegratorParameters:
+    newmark_beta: float
+    newmark_gamma: float
+    rho_inf: float
+    def __init__(self) -> None: ...
 
 class LinearSolver(_Enum):
     CG: ClassVar[LinearSolver]
@@ -116,6 +134,8 @@ class SolverSettings:
     stiffness_interval: int
     fail_on_unconverged: bool
     max_energy_growth: float
+    preconditioner: str
+    amg_refresh_interval: int
     def __init__(self) -> None: ...
 
 class Scene:
@@ -144,6 +164,12 @@ class Scene:
     prescribed: list[tuple[int, tuple[float, float, float]]]
     prescribed_steps: int
     integrator: Integrator
+    integrator_parameters: IntegratorParameters
+    prescribed_keyframes: list[Keyframe]
+    load: list[float]
+    load_keyframes: list[Keyframe]
+    initial_displacement: list[float]
+    initial_velocity: list[float]
     dt: float
     steps: int
     solver: SolverSettings
@@ -212,6 +238,8 @@ class StepStats:
     def newton_round_off(self) -> bool: ...
     @property
     def energy_growth(self) -> float: ...
+    @property
+    def symbolic_analyses(self) -> int: ...
 
 class Energies:
     @property

@@ -9,6 +9,7 @@
 // matrix-free ones (the per-edge K on the back-end's executor). A
 // whole-vector preconditioner: one V-cycle per CG iteration. On the host.
 #include <array>
+#include <string>
 
 #include "edgefem/core/smoothed_aggregation.hpp"
 #include "solvers/preconditioner.hpp"
@@ -75,6 +76,10 @@ private:
 
 template <class S>
 std::unique_ptr<Preconditioner<S>> make_amg(const SimState<S>& state) {
+    // Its levels read and write r and z on the host.
+    if (state.backend->memory().space() != MemorySpace::Host)
+        throw InvalidArgument(std::string("solver.preconditioner: amg runs on the host; the ") + state.backend->name() +
+                              " back-end's vectors are not in host memory (use block-jacobi)");
     return std::make_unique<Amg<S>>(state);
 }
 
