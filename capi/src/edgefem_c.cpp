@@ -18,6 +18,7 @@
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
+#include "edgefem/core/surface.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/parallel/run_options.hpp"
 
@@ -268,6 +269,27 @@ edgefem_status edgefem_scene_get_tets(const edgefem_scene* scene, int32_t* out, 
         if (count != T.size())
             invalid("out: count is " + std::to_string(count) + ", expected 4 x #T = " + std::to_string(T.size()));
         std::copy(T.begin(), T.end(), out);
+    });
+}
+
+edgefem_status edgefem_scene_boundary_count(const edgefem_scene* scene, size_t* num_triangles) {
+    return guard("edgefem_scene_boundary_count", [&] {
+        require(scene, "scene");
+        require(num_triangles, "num_triangles");
+        *num_triangles = edgefem::boundary_surface(scene->scene.mesh).triangles.size();
+    });
+}
+
+edgefem_status edgefem_scene_get_boundary(const edgefem_scene* scene, int32_t* out, size_t count) {
+    return guard("edgefem_scene_get_boundary", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        const auto tri = edgefem::boundary_surface(scene->scene.mesh).triangles;
+        if (count != 3 * tri.size())
+            invalid("out: count is " + std::to_string(count) + ", expected 3 x (boundary triangles) = " +
+                    std::to_string(3 * tri.size()));
+        for (std::size_t k = 0; k < tri.size(); ++k)
+            for (int i = 0; i < 3; ++i) out[3 * k + i] = tri[k][i];
     });
 }
 

@@ -33,6 +33,7 @@
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
+#include "edgefem/core/surface.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/core/write_vtu.hpp"
 #include "edgefem/parallel/run_options.hpp"
@@ -98,15 +99,15 @@ InArray vectors_arg(py::handle obj, const std::string& name, py::ssize_t rows, b
     return out;
 }
 
-// A (T, 4) integer array of vertex indices as index_t, refusing floats and
+// A (rows, cols) integer array of vertex indices (tets: (T, 4)) as index_t, refusing floats and
 // any value a 32-bit index cannot hold (instead of truncating or wrapping).
 // Whether the indices are in range is the mesh validation's to say.
-std::vector<index_t> tets_arg(py::handle obj) {
-    const py::array a = as_array(obj, "tets");
+std::vector<index_t> index_rows_arg(py::handle obj, const std::string& name, py::ssize_t cols) {
+    const py::array a = as_array(obj, name);
     const char kind = a.dtype().kind();
     if (kind != 'i' && kind != 'u')
-        throw InvalidArgument("tets: dtype " + dtype_of(a) + " is not an integer type (vertex indices)");
-    require_shape(a, "tets", -1, 4, "T");
+        throw InvalidArgument(name + ": dtype " + dtype_of(a) + " is not an integer type (vertex indices)");
+    require_shape(a, name, -1, cols, cols == 4 ? "T" : "F");
     std::vector<index_t> tets(std::size_t(a.size()));
     const auto copy = [&](const auto& values) {
         for (std::size_t i = 0; i < tets.size(); ++i) {
@@ -116,7 +117,7 @@ std::vector<index_t> tets_arg(py::handle obj) {
             bool fits = v <= hi;
             if constexpr (std::is_signed_v<V>) fits = fits && v >= V(std::numeric_limits<index_t>::min());
             if (!fits)
-                throw InvalidArgument("tets[" + std::to_string(i / 4) + ", " + std::to_string(i % 4) +
+                throw InvalidArgument(name + "[" + std::to_string(i / std::size_t(cols)) + ", " + std::to_string(i % std::size_t(cols)) +
                                       "] = " + std::to_string(v) + " does not fit a 32-bit vertex index");
             tets[i] = index_t(v);
         }
@@ -127,6 +128,7 @@ std::vector<index_t> tets_arg(py::handle obj) {
         copy(py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a));
     return tets;
 }
+std::vector<index_t> tets_arg(py::handle obj) { return index_rows_arg(obj, "tets", 4); }
 
 py::array_t<double> new_vectors(const std::vector<double>& v) {
     py::array_t<double> out({py::ssize_t(v.size() / 3), py::ssize_t(3)});
@@ -682,6 +684,70 @@ PYBIND11_MODULE(_edgefem, m) {
         },
         py::arg("mesh"), py::arg("kind") = "twist", py::arg("scale") = 1.0,
         "A test displacement: 'twist', 'rotate', 'random' or 'affine' (as the CLI's --deform).");
+
+    // ---- surfaces for rendering (surface.hpp) ----
+    m.def(
+        "boundary_surface",
+        [](const Mesh& mesh) {
+            const BoundarySurface b = boundary_surface(mesh);
+            py::array_t<std::int32_t> tri({py::ssize_t(b.triangles.size()), py::ssize_t(3)});
+            py::array_t<std::int32_t> tet(py::ssize_t(b.tet.size()));
+            for (std::size_t k = 0; k < b.triangles.size(); ++k) {
+                for (int i = 0; i < 3; ++i) tri.mutable_data()[3 * k + i] = b.triangles[k][i];
+                tet.mutable_data()[k] = b.tet[k];
+            }
+            return py::make_tuple(tri, tet);
+        },
+        py::arg("mesh"),
+        "The mesh's boundary: (triangles (F, 3) wound outward, the tet of each (F,)).");
+    py::class_<Embedding>(m, "Embedding", "Points of a render surface placed in a mesh's tets (embed_points).")
+        .def_property_readonly("tet",
+                               [](const Embedding& e) {
+                                   py::array_t<std::int32_t> a(py::ssize_t(e.tet.size()));
+                                   std::copy(e.tet.begin(), e.tet.end(), a.mutable_data());
+                                   return a;
+                               })
+        .def_property_readonly("weight",
+                               [](const Embedding& e) {
+                                   py::array_t<double> a({py::ssize_t(e.weight.size()), py::ssize_t(4)});
+                                   for (std::size_t p = 0; p < e.weight.size(); ++p)
+                                       std::copy(e.weight[p].begin(), e.weight[p].end(), a.mutable_data() + 4 * p);
+                                   return a;
+                               })
+        .def_property_readonly("outside", [](const Embedding& e) {
+            py::array_t<double> a(py::ssize_t(e.outside.size()));
+            std::copy(e.outside.begin(), e.outside.end(), a.mutable_data());
+            return a;
+        });
+    m.def(
+        "embed_points",
+        [](const Mesh& mesh, py::handle points) {
+            const InArray p = vectors_arg(points, "points", -1, true);
+            return embed_points(mesh, std::span<const double>(p.data(), std::size_t(p.size())));
+        },
+        py::arg("mesh"), py::arg("points"),
+        "Places points (P, 3) in the mesh's tets (outside the mesh: the nearest tet), once.");
+    m.def(
+        "embedded_positions",
+        [](const Mesh& mesh, const Embedding& e, py::handle u_in) {
+            const InArray u = vectors_arg(u_in, "u", mesh.num_vertices(), true);
+            std::vector<double> out(3 * e.tet.size());
+            embedded_positions<double>(mesh, e, std::span<const double>(u.data(), std::size_t(u.size())), out);
+            return new_vectors(out);
+        },
+        py::arg("mesh"), py::arg("embedding"), py::arg("u"),
+        "The embedded points (P, 3) at the displacement u (#V, 3).");
+    m.def(
+        "vertex_normals",
+        [](py::handle triangles, py::handle positions) {
+            const InArray x = vectors_arg(positions, "positions", -1, true);
+            const std::vector<index_t> t = index_rows_arg(triangles, "triangles", 3);
+            std::vector<std::array<index_t, 3>> tri(t.size() / 3);
+            for (std::size_t k = 0; k < tri.size(); ++k) tri[k] = {t[3 * k], t[3 * k + 1], t[3 * k + 2]};
+            return new_vectors(vertex_normals(tri, std::span<const double>(x.data(), std::size_t(x.size()))));
+        },
+        py::arg("triangles"), py::arg("positions"),
+        "Area-weighted unit vertex normals (#V, 3) of triangles (F, 3) over positions (#V, 3).");
 
     // ---- benchmarks ----
     m.def(

@@ -311,6 +311,18 @@ int main(void) {
         expect_error(edgefem_scene_get_tets(scene, tets_out, 4 * (size_t)nt - 1), EDGEFEM_ERROR_INVALID_ARGUMENT,
                      "4 x #T", "short tets buffer");
         free(tets_out);
+        /* The boundary of the 4 x 2 x 2 box: 2 triangles per cube face, 4 (8 + 4 + 8) = 80. */
+        edgefem_scene* box = NULL;
+        CHECK_OK(edgefem_scene_create_box(4, 2, 2, 0.01, &box));
+        size_t nb = 0;
+        CHECK_OK(edgefem_scene_boundary_count(box, &nb));
+        CHECK(nb == 80);
+        int32_t tri[3 * 80];
+        CHECK_OK(edgefem_scene_get_boundary(box, tri, 3 * nb));
+        for (size_t k = 0; k < 3 * nb; ++k) CHECK(tri[k] >= 0 && tri[k] < 45);
+        expect_error(edgefem_scene_get_boundary(box, tri, 3 * nb - 1), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                     "3 x (boundary triangles)", "short boundary buffer");
+        edgefem_scene_destroy(box);
         edgefem_scene* pres = NULL;
         CHECK_OK(edgefem_scene_create_box(4, 2, 2, 0.01, &pres));
         const int32_t clamp[] = {0, 5, 10, 15};                     /* x = min end of the 5 x 3 x 3 grid */

@@ -160,6 +160,11 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_rest_positions(const edgefem_s
 /** Copies the tets: 4 vertex indices per tet (count = 4 x num_tets), as
  *  validated (every tet positively oriented). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_tets(const edgefem_scene* scene, int32_t* out, size_t count);
+/** The mesh's boundary for rendering: the faces of exactly one tet, wound so
+ *  that (b - a) x (c - a) points out of the body. Its triangle count, then
+ *  the triangles (3 vertex indices each; count = 3 x num_triangles). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_boundary_count(const edgefem_scene* scene, size_t* num_triangles);
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_boundary(const edgefem_scene* scene, int32_t* out, size_t count);
 /** One material for the whole mesh: Young's modulus (Pa), Poisson ratio in
  *  (-1, 0.5), density (kg/m^3). */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_material(edgefem_scene* scene, double young, double poisson,
