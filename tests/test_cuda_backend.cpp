@@ -39,13 +39,11 @@ namespace {
 using test::evaluate;
 using test::expect_close;
 using test::Outputs;
-using test::rel_max;
+using test::rel_diff;
 
 const Materials& material() { return test::backend_test_material(); }
 
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
+using test::bitwise_equal;
 
 using test::Case;
 using test::kCases;
@@ -92,7 +90,7 @@ TEST(CudaBackend, OperatorsMatchTheReference) {
             // Two runs: the same bits (no atomics, fixed reduction order).
             auto op2 = dev->make_operator(nm.mesh, material(), c.model, c.method);
             const Outputs b = evaluate(*op2, u, x, edge, dev->memory());
-            EXPECT_TRUE(same_bits(a.f, b.f) && same_bits(a.Kx, b.Kx) && same_bits(a.D, b.D) && a.energy == b.energy)
+            EXPECT_TRUE(bitwise_equal(a.f, b.f) && bitwise_equal(a.Kx, b.Kx) && bitwise_equal(a.D, b.D) && a.energy == b.energy)
                 << c.name << " two runs differ";
             auto opf = devf->make_operator(nm.mesh, material(), c.model, c.method);
             expect_close(evaluate(*opf, u, x, edge, devf->memory()), ref, 1e-5, std::string(c.name) + " float");
@@ -120,8 +118,8 @@ TEST(CudaBackend, SimulationsMatchTheCpuBackend) {
             for (int k = 0; k < r.steps; ++k) s->step();
         }
         const std::string what = std::string(to_string(r.integrator)) + (r.static_first ? " after static" : "");
-        EXPECT_LE(rel_max(gpu.positions(), cpu.positions()), 1e-9) << what;
-        EXPECT_TRUE(same_bits(gpu.positions(), gpu2.positions())) << what << ": two GPU runs differ";
+        EXPECT_LE(rel_diff(gpu.positions(), cpu.positions()), 1e-9) << what;
+        EXPECT_TRUE(bitwise_equal(gpu.positions(), gpu2.positions())) << what << ": two GPU runs differ";
         EXPECT_EQ(gpu.last_stats().solver_iterations, gpu2.last_stats().solver_iterations) << what;
     }
 }
@@ -135,7 +133,7 @@ TEST(CudaBackend, BeamThousandStepsMatchTheCpuTrajectory) {
     for (int k = 0; k < scene.steps; ++k) {
         cpu.step();
         gpu.step();
-        if (k % 100 == 99) worst = std::max(worst, rel_max(gpu.positions(), cpu.positions()));
+        if (k % 100 == 99) worst = std::max(worst, rel_diff(gpu.positions(), cpu.positions()));
     }
     EXPECT_LE(worst, 1e-9);
     std::printf("beam, 1000 semi-implicit steps: GPU against CPU, worst relative difference %.3g\n", worst);

@@ -56,10 +56,7 @@ const std::vector<NamedExecutor>& executors() {
     return list;
 }
 
-template <class T>
-bool bitwise_equal(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using test::bitwise_equal;
 
 // The outputs of one run of every kernel.
 template <class S>

@@ -48,9 +48,7 @@ Result run(Method method, std::shared_ptr<const Executor> ex, OperatorFactory<do
     return r;
 }
 
-bool same(const std::vector<double>& a, const std::vector<double>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
+using test::bitwise_equal;
 
 }  // namespace
 
@@ -70,8 +68,8 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
                     const Result par = run(method, ex, cpu_operator_factory<double>({ex, var}));
                     const std::string where = tag + "/" + to_string(b) + "-" + std::to_string(t);
                     if (is_deterministic(var) || (method == Method::Tet && var != Variant::Private)) {
-                        EXPECT_TRUE(same(par.u, serial.u)) << where << " " << rel_diff(par.u, serial.u);
-                        EXPECT_TRUE(same(par.v, serial.v)) << where;
+                        EXPECT_TRUE(bitwise_equal(par.u, serial.u)) << where << " " << rel_diff(par.u, serial.u);
+                        EXPECT_TRUE(bitwise_equal(par.v, serial.v)) << where;
                         EXPECT_EQ(par.iterations, serial.iterations) << where;
                         EXPECT_EQ(par.elastic, serial.elastic) << where;
                     } else {
@@ -145,7 +143,7 @@ TEST(ParallelSimulator, ImplicitAndStaticDeterministic) {
         for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
             for (int t : edgefem::test::test_thread_counts()) {
                 const auto ex = make_executor(b, t);
-                EXPECT_TRUE(same(run_both(ex, cpu_operator_factory<double>({ex, var})), serial))
+                EXPECT_TRUE(bitwise_equal(run_both(ex, cpu_operator_factory<double>({ex, var})), serial))
                     << to_string(var) << "/" << to_string(b) << "-" << t;
             }
     }

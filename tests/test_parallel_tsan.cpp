@@ -45,10 +45,7 @@ private:
     int threads_;
 };
 
-template <class T>
-bool same(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using test::bitwise_equal;
 
 }  // namespace
 
@@ -78,7 +75,7 @@ TEST(ParallelTsan, EdgeKernels) {
                 if (threads == 1) {
                     ref_f = f, ref_y = y, ref_D = D, ref_K = Ke;
                 } else if (is_deterministic(v)) {
-                    EXPECT_TRUE(same(f, ref_f) && same(y, ref_y) && same(D, ref_D) && same(Ke, ref_K)) << to_string(v);
+                    EXPECT_TRUE(bitwise_equal(f, ref_f) && bitwise_equal(y, ref_y) && bitwise_equal(D, ref_D) && bitwise_equal(Ke, ref_K)) << to_string(v);
                 } else {
                     EXPECT_LE(edgefem::test::rel_diff(f, ref_f), 1e-12);
                     EXPECT_LE(edgefem::test::rel_diff(Ke, ref_K), 1e-12);
@@ -105,7 +102,7 @@ TEST(ParallelTsan, TetKernelsAndStep) {
                 u.emplace_back(sim.displacement().begin(), sim.displacement().end());
             }
             if (is_deterministic(v) || (method == Method::Tet && v != Variant::Private))
-                EXPECT_TRUE(same(u[0], u[1]));
+                EXPECT_TRUE(bitwise_equal(u[0], u[1]));
             else
                 EXPECT_LE(edgefem::test::rel_diff(u[1], u[0]), 1e-12);
         }
@@ -126,7 +123,7 @@ TEST(ParallelTsan, AdaptiveExecutor) {
         a.step();
         b.step();
     }
-    EXPECT_TRUE(same(std::vector<double>(a.displacement().begin(), a.displacement().end()),
+    EXPECT_TRUE(bitwise_equal(std::vector<double>(a.displacement().begin(), a.displacement().end()),
                      std::vector<double>(b.displacement().begin(), b.displacement().end())));
 
     std::vector<std::atomic<int>> hits(2 * 16);
@@ -159,7 +156,7 @@ TEST(ParallelTsan, PoolExecutor) {
         }
         for (std::size_t k = 1; k < u.size(); ++k) {
             if (is_deterministic(v))
-                EXPECT_TRUE(same(u[0], u[k])) << to_string(v);
+                EXPECT_TRUE(bitwise_equal(u[0], u[k])) << to_string(v);
             else
                 EXPECT_LE(edgefem::test::rel_diff(u[k], u[0]), 1e-12) << to_string(v);
         }
@@ -186,7 +183,7 @@ TEST(ParallelTsan, PoolNewton) {
         u.insert(u.end(), st.displacement().begin(), st.displacement().end());
         out.push_back(std::move(u));
     }
-    EXPECT_TRUE(same(out[0], out[1]));
+    EXPECT_TRUE(bitwise_equal(out[0], out[1]));
 }
 
 // Linked phases on the pool: each chunk writes plain (non-atomic) data that

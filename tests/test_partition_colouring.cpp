@@ -56,10 +56,7 @@ const std::vector<PartMesh>& part_meshes() {
     return list;
 }
 
-template <class T>
-bool bitwise_equal(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using test::bitwise_equal;
 
 // Every item of [0, n) exactly once over all colours.
 bool covers_once(const Colouring& c, index_t n) {

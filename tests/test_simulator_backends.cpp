@@ -27,9 +27,7 @@ using edgefem::test::rel_diff;
 
 namespace {
 
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
+using test::bitwise_equal;
 
 // Host memory that says it is device memory: host() refuses it, while the
 // CPU kernels still run on it.
@@ -384,7 +382,7 @@ TEST(VectorKernels, ReferenceAndCpuAgree) {
     EXPECT_LE(worst, 1e-12) << "at output " << worst_at;
     for (int threads : {2, 3}) {
         const auto ex = make_executor(ExecutorKind::OpenMP, threads);
-        EXPECT_TRUE(same_bits(run_kernels(make_cpu_backend<double>(ex)->kernels(), in), serial)) << threads;
+        EXPECT_TRUE(bitwise_equal(run_kernels(make_cpu_backend<double>(ex)->kernels(), in), serial)) << threads;
     }
 }
 
@@ -438,9 +436,9 @@ TEST(VectorKernels, CgReferenceAndFusedAgree) {
     for (int threads : {2, 3}) {
         const auto ex = make_executor(ExecutorKind::OpenMP, threads);
         const CgRun par = run_cg(make_cpu_backend<double>(ex)->kernels(), in, 0);
-        EXPECT_TRUE(same_bits(par.x, cpu.x)) << threads;
+        EXPECT_TRUE(bitwise_equal(par.x, cpu.x)) << threads;
         EXPECT_EQ(par.res.iterations, cpu.res.iterations);
-        EXPECT_TRUE(same_bits(run_cg(make_cpu_backend<double>(ex)->kernels(), in, 7).x, fixed.x)) << threads;
+        EXPECT_TRUE(bitwise_equal(run_cg(make_cpu_backend<double>(ex)->kernels(), in, 7).x, fixed.x)) << threads;
     }
 }
 
@@ -471,7 +469,7 @@ TEST(Backends, SimulatorOnReferenceAndCpuAgree) {
             simulate(c.scene, make_cpu_backend<double>(omp2, cpu_operator_factory<double>({omp2, Variant::Gather})),
                      c.steps, c.static_first);
         EXPECT_LE(rel_diff(serial.state, ref.state), 1e-10) << c.name;
-        EXPECT_TRUE(same_bits(two.state, serial.state)) << c.name;
+        EXPECT_TRUE(bitwise_equal(two.state, serial.state)) << c.name;
         EXPECT_LE(rel_diff(gather.state, ref.state), 1e-10) << c.name;
     }
 }
@@ -492,13 +490,13 @@ TEST(Backends, CpuBackendBitwiseAcrossThreadCounts) {
         const std::vector<double> u(adapter.displacement().begin(), adapter.displacement().end());
         const std::vector<double> tail(base.state.end() - 2 * std::ptrdiff_t(u.size()),
                                        base.state.end() - std::ptrdiff_t(u.size()));
-        EXPECT_TRUE(same_bits(u, tail));
+        EXPECT_TRUE(bitwise_equal(u, tail));
     }
     for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
         for (int t : test::test_thread_counts()) {
             const auto ex = make_executor(b, t);
             const SimRun par = simulate(scene, gather_backend(ex), 2);
-            EXPECT_TRUE(same_bits(par.state, base.state)) << to_string(b) << "-" << t;
+            EXPECT_TRUE(bitwise_equal(par.state, base.state)) << to_string(b) << "-" << t;
             EXPECT_EQ(par.iterations, base.iterations);
         }
 }
@@ -519,7 +517,7 @@ TEST(Backends, DeviceMemoryIsNeverReadOnTheHostInAStep) {
             if (static_first) s->solve_static();
             for (int k = 0; k < steps; ++k) s->step();
         }
-        EXPECT_TRUE(same_bits(sim.positions(), cpu.positions()));
+        EXPECT_TRUE(bitwise_equal(sim.positions(), cpu.positions()));
         EXPECT_EQ(sim.energies().kinetic, cpu.energies().kinetic);
         const auto same = [](auto a, auto b) { return std::equal(a.begin(), a.end(), b.begin(), b.end()); };
         EXPECT_TRUE(same(sim.displacement(), cpu.displacement()));
@@ -531,8 +529,8 @@ TEST(Backends, DeviceMemoryIsNeverReadOnTheHostInAStep) {
             s->velocity()[16] += 1e-3;
         }
         for (Simulator<double>* s : {&sim, &untouched, &cpu}) s->step();
-        EXPECT_TRUE(same_bits(sim.positions(), cpu.positions()));
-        EXPECT_FALSE(same_bits(sim.positions(), untouched.positions()));
+        EXPECT_TRUE(bitwise_equal(sim.positions(), cpu.positions()));
+        EXPECT_FALSE(bitwise_equal(sim.positions(), untouched.positions()));
         EXPECT_TRUE(same(sim.forces(), cpu.forces()));
     }
     // The AMG preconditioner runs on the host: refused by name, not a crash.
@@ -582,7 +580,7 @@ TEST(Backends, EveryIntegratorOnEveryBackend) {
             sim.step();
             host.step();
         }
-        EXPECT_TRUE(same_bits(sim.positions(), host.positions()));
+        EXPECT_TRUE(bitwise_equal(sim.positions(), host.positions()));
     }
 }
 

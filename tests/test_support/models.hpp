@@ -2,6 +2,8 @@
 // would, plus comparison helpers with explicit tolerances.
 #pragma once
 
+#include <cstring>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -49,6 +51,12 @@ inline double rel_diff(const auto& a, const auto& b) {
     for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::abs(double(a[i]) - double(b[i])));
     const double s = max_abs(b);
     return s > 0 ? d / s : d;
+}
+
+// The same length and the same bits (no tolerance).
+template <class T>
+bool bitwise_equal(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
 inline double dot(const std::vector<double>& a, const std::vector<double>& b) {
