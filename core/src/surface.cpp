@@ -6,21 +6,13 @@
 #include <string>
 
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/validate_mesh.hpp"
 
 namespace edgefem {
 
 namespace {
 
 const double* vertex(const Mesh& m, index_t v) { return &m.X[3 * std::size_t(v)]; }
-
-void check_indices(const Mesh& m, const char* what) {
-    const index_t nv = m.num_vertices();
-    if (m.tets.size() % 4 != 0) throw MeshError(std::string(what) + ": the tet array's length is not a multiple of 4");
-    for (std::size_t k = 0; k < m.tets.size(); ++k)
-        if (m.tets[k] < 0 || m.tets[k] >= nv)
-            throw MeshError(std::string(what) + ": " + m.describe_tet(index_t(k / 4)) + " names vertex " +
-                            std::to_string(m.tets[k]) + ", outside 0.." + std::to_string(nv - 1));
-}
 
 void sub(const double* a, const double* b, double* d) {
     for (int i = 0; i < 3; ++i) d[i] = a[i] - b[i];
@@ -125,7 +117,7 @@ std::vector<index_t> BoundarySurface::vertices() const {
 }
 
 BoundarySurface boundary_surface(const Mesh& mesh) {
-    check_indices(mesh, "boundary_surface");
+    check_mesh_indices(mesh);
     struct Face {
         std::array<index_t, 3> key;
         index_t tet;
@@ -176,7 +168,7 @@ Embedding embed_points(const Mesh& mesh, std::span<const double> points) {
         if (!std::isfinite(points[k]))
             throw InvalidArgument("embed_points: point " + std::to_string(k / 3) + " has a non-finite coordinate");
     if (mesh.num_tets() == 0) throw MeshError("embed_points: the mesh has no tets");
-    check_indices(mesh, "embed_points");
+    check_mesh_indices(mesh);
     const TetGrid grid(mesh);
     const std::size_t np = points.size() / 3;
     Embedding e;

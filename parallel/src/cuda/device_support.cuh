@@ -79,12 +79,4 @@ private:
     std::size_t size_ = 0;
 };
 
-// Compressed rows on the device: item i's entries are entry[first[i] ..
-// first[i + 1]).
-template <class T>
-struct DeviceLists {
-    DeviceArray<index_t> first;
-    DeviceArray<T> entry;
-};
-
 }  // namespace edgefem::cuda

@@ -26,7 +26,8 @@ struct BoundarySurface {
     std::vector<index_t> vertices() const;
 };
 
-// Throws MeshError for an index out of range.
+// Throws MeshError for a tet naming a vertex outside the mesh or one twice
+// (check_mesh_indices).
 BoundarySurface boundary_surface(const Mesh& mesh);
 
 // Where each point of a render surface sits in a mesh: its tet and its
@@ -42,7 +43,7 @@ struct Embedding {
 
 // points: 3 P coordinates. Throws InvalidArgument naming the first
 // non-finite point or a length that is not a multiple of 3; MeshError for an
-// empty mesh.
+// empty mesh or bad indices (check_mesh_indices).
 Embedding embed_points(const Mesh& mesh, std::span<const double> points);
 
 // out (3 P) = the embedded points at displacement u (3 #V): sum over the
