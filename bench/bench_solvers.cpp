@@ -18,12 +18,15 @@
 #include <HYPRE_parcsr_ls.h>
 #include <mpi.h>
 
+#include <dlfcn.h>
+
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <sstream>
@@ -131,14 +134,28 @@ LowerCsc lower_of(const Eigen::SparseMatrix<double>& A) {
     return out;
 }
 
+// The file the BLAS that CHOLMOD calls was loaded from (Debian's
+// libblas.so.3 alternative: reference BLAS or OpenBLAS), so that a figure
+// says which BLAS produced it.
+std::string blas_library() {
+    void* dgemm = dlsym(RTLD_DEFAULT, "dgemm_");
+    Dl_info info{};
+    if (dgemm == nullptr || dladdr(dgemm, &info) == 0 || info.dli_fname == nullptr) return "unknown";
+    char* real = realpath(info.dli_fname, nullptr);  // through the alternatives' links
+    const std::string path = real != nullptr ? real : info.dli_fname;
+    std::free(real);
+    return path;
+}
+
 void bench_direct(int rounds) {
     Scene s = default_scene();
     for_solve(s, 1, PreconditionerKind::BlockJacobi);
     const std::vector<double> u = state_after(s, 5);
     auto op = cpu_operator_factory<double>()(s.mesh, s.materials, s.model, s.method);
     Assembled a = assemble_at(s, *op, u, false);
-    std::printf("\n## direct: built-in beam, %ld free dofs, %ld stored entries (A = M + dt^2 K after 5 steps)\n\n",
-                long(a.A.rows()), long(a.A.nonZeros()));
+    std::printf("\n## direct: built-in beam, %ld free dofs, %ld stored entries (A = M + dt^2 K after 5 steps)\n\n"
+                "BLAS: %s\n\n",
+                long(a.A.rows()), long(a.A.nonZeros()), blas_library().c_str());
     SparseCholesky chol;
     auto t0 = Clock::now();
     chol.factor(lower_of(a.A));

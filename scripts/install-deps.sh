@@ -9,6 +9,7 @@ packages=(
   libtbb-dev          # TBB back-end
   libmetis-dev        # partitioning / reordering
   libsuitesparse-dev  # CHOLMOD: the direct solver
+  libopenblas0-serial # BLAS behind CHOLMOD's supernodal factorisation (4x the reference BLAS; docs/solvers.md)
   libhypre-dev        # benchmarks: hypre BoomerAMG, the AMG preconditioner's comparison
   libgtest-dev        # tests
   libbenchmark-dev    # benchmarks
