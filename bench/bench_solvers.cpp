@@ -13,7 +13,9 @@
 //          BoomerAMG (systems AMG, 3 functions, nodal coarsening) on the same
 //          matrix; memory of each preconditioner against the per-edge K's.
 // Medians over rounds; serial (one thread). Usage:
-//   edgefem_bench_solvers [--meshes beam,bunny-4k] [--dts 1,4,10] [--rounds 9] [--quick]
+//   edgefem_bench_solvers [--meshes beam,bunny-4k] [--dts 1,4,10] [--rounds 9] [--parts direct,step,matrix]
+//                         [--amg-smoothing N] [--amg-coarse DOFS] [--quick]
+// (--amg-*: the matrix part's AmgSettings, to study the hierarchy)
 #include <HYPRE.h>
 #include <HYPRE_parcsr_ls.h>
 #include <mpi.h>
@@ -146,6 +148,8 @@ std::string blas_library() {
     std::free(real);
     return path;
 }
+
+AmgSettings g_amg;  // the matrix part's AMG settings (--amg-smoothing, --amg-coarse)
 
 void bench_direct(int rounds) {
     Scene s = default_scene();
@@ -429,7 +433,7 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
                 its_bj.push_back(pcg(A, b, x_bj, 1e-6, bj_apply));
                 t_bj.push_back(ms_since(t0));
                 t0 = Clock::now();
-                if (r == 0) sa.build(A, s.mesh.X, all.free);
+                if (r == 0) sa.build(A, s.mesh.X, all.free, g_amg);
                 else sa.refresh(A);
                 (r == 0 ? setup_sa : refresh_sa).push_back(ms_since(t0));
                 t0 = Clock::now();
@@ -488,6 +492,8 @@ int main(int argc, char** argv) {
             for (const std::string& d : split(next())) dts.push_back(std::stod(d));
         } else if (a == "--rounds") rounds = std::max(1, std::stoi(next()));
         else if (a == "--parts") parts = next();
+        else if (a == "--amg-smoothing") g_amg.smoothing_steps = std::max(1, std::stoi(next()));
+        else if (a == "--amg-coarse") g_amg.max_coarse_dofs = std::max(1, std::stoi(next()));
         else if (a == "--quick") {
             meshes = {"box-1200"};
             dts = {4};
