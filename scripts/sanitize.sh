@@ -9,7 +9,9 @@
 # extension needs the sanitizer runtime preloaded into python3), and under
 # TSan the OpenMP and TBB executors' tests, whose runtimes are not
 # instrumented (parallel/README.md, "ThreadSanitizer": the std::thread
-# executors, test_parallel_tsan, are what TSan checks).
+# executors, test_parallel_tsan, are what TSan checks). The CUDA back-end
+# (nvcc compiles its host code without the sanitizer) and the Python module
+# (its tests are left out) are not built.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 kind=${1:?usage: scripts/sanitize.sh address|thread [ctest args...]}
@@ -33,6 +35,7 @@ case "$kind" in
     *) echo "sanitize: expected 'address' or 'thread', got '$kind'" >&2; exit 2 ;;
 esac
 cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEDGEFEM_BUILD_BENCHMARKS=OFF \
+    -DEDGEFEM_CUDA=OFF -DEDGEFEM_BUILD_PYTHON=OFF \
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_C_FLAGS="$flags" \
     -DCMAKE_EXE_LINKER_FLAGS="${flags%% *}" -DCMAKE_SHARED_LINKER_FLAGS="${flags%% *}" >/dev/null
 cmake --build "$dir" -j "$(nproc)"
