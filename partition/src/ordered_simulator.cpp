@@ -68,6 +68,7 @@ template <class S>
 OrderedSimulator<S>::OrderedSimulator(const Scene& scene, Ordering ordering, std::shared_ptr<const Backend<S>> backend,
                                       const OrderingOptions& options)
     : user_scene_((scene.validate(), scene)),
+      ordering_(to_string(ordering)),
       new_of_old_(non_identity(vertex_ordering(scene.mesh, ordering, options))),
       sim_(identity() ? scene : permute_scene(scene, new_of_old_), std::move(backend)) {
     if (identity()) return;
@@ -147,6 +148,21 @@ StaticResult OrderedSimulator<S>::solve_static() {
         pull();
         throw to_user_numbering(e, new_of_old_);
     }
+}
+
+template <class S>
+void OrderedSimulator<S>::save_checkpoint(const std::string& path) {
+    const InUseFlag::Claim claim(in_use_, "save_checkpoint");
+    push();
+    sim_.save_checkpoint(path, ordering_);
+}
+
+template <class S>
+void OrderedSimulator<S>::load_checkpoint(const std::string& path) {
+    const InUseFlag::Claim claim(in_use_, "load_checkpoint");
+    sim_.load_checkpoint(path, ordering_);
+    pull();
+    if (!identity()) gather<S, S>(sim_.external_forces(), fext_, new_of_old_, false);
 }
 
 template <class S>

@@ -19,12 +19,7 @@ public:
         s_.external(1.0);
         BackendVector<double> u0 = s_.template vector<double>(n), upred = s_.template vector<double>(n);
         s_.kernels.implicit_predict(u0.data(), upred.data(), s_.u.data(), s_.v.data(), T, n);
-        if (scene.rayleigh_beta > 0) {
-            if (!op_damp_) op_damp_ = s_.backend->make_operator(scene.mesh, scene.materials, scene.model, scene.method);
-            BackendVector<S> scratch = s_.template vector<S>(n);
-            op_damp_->forces(s_.u.data(), scratch.data(), false);
-            op_damp_->build_stiffness(scene.solver.definite_stiffness);
-        }
+        if (scene.rayleigh_beta > 0) s_.build_damping_tangent(op_damp_);
         // Start from the prediction with the constrained dofs at their targets.
         const double s = s_.ramp(s_.time + T);
         s_.kernels.to_state(s_.u.data(), upred.data(), n);

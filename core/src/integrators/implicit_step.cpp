@@ -23,12 +23,7 @@ void ImplicitStep<S>::begin(double T) {
     s_.external(1.0);
     s_.kernels.from_state(u0_.data(), s_.u.data(), n);
     s_.constrained_velocities(T, s_.time + T, cvel_.data());
-    if (scene.rayleigh_beta > 0) {
-        if (!op_damp_) op_damp_ = s_.backend->make_operator(scene.mesh, scene.materials, scene.model, scene.method);
-        BackendVector<S> scratch = s_.template vector<S>(n);
-        op_damp_->forces(s_.u.data(), scratch.data(), false);
-        op_damp_->build_stiffness(scene.solver.definite_stiffness);
-    }
+    if (scene.rayleigh_beta > 0) s_.build_damping_tangent(op_damp_);
 }
 
 template <class S>

@@ -35,6 +35,15 @@ public:
         return std::nullopt;
     }
 
+    void save(CheckpointWriter& w) const override {
+        w.value(stiffness_age_);
+        w.value(stiffness_dt_);
+    }
+    void load(CheckpointReader& r) override {
+        stiffness_age_ = r.value<int>("stiffness age");
+        stiffness_dt_ = r.value<double>("stiffness step size");
+    }
+
 private:
     SimState<S>& s_;
     TangentSolve<S>& solve_;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 
+#include "simulator/checkpoint_stream.hpp"
 #include "simulator/state.hpp"
 #include "solvers/tangent_solve.hpp"
 
@@ -23,6 +24,9 @@ public:
     // Whether its steps build K (if not, the operator need not keep the
     // state K is built from).
     virtual bool builds_stiffness() const { return true; }
+    // Its own state beyond the history (SimState::history), for a checkpoint.
+    virtual void save(CheckpointWriter& /*w*/) const {}
+    virtual void load(CheckpointReader& /*r*/) {}
 };
 
 // The scene's integrator.

@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "simulator/checkpoint_stream.hpp"
 #include "simulator/state.hpp"
 
 namespace edgefem::sim {
@@ -46,6 +47,18 @@ public:
     // After a step of size T that started at `start` and ends with elastic
     // energy W_end.
     void check(double T, const EnergySample& start, double W_end, bool constraints_moved);
+
+    // For a checkpoint: the gain counted and the largest energy seen (the
+    // next start evaluates the forces again).
+    void save(CheckpointWriter& w) const {
+        w.value(energy_excess_);
+        w.value(energy_scale_);
+    }
+    void load(CheckpointReader& r) {
+        energy_excess_ = r.value<double>("energy gain");
+        energy_scale_ = r.value<double>("energy scale");
+        forget();
+    }
 
 private:
     EnergySample sample(double W) const;

@@ -4,10 +4,13 @@
 // write the state.
 #include "edgefem/core/simulator.hpp"
 
+#include <type_traits>
 #include <utility>
 
 #include "edgefem/core/finite_input.hpp"
 #include "edgefem/core/in_use_flag.hpp"
+#include "edgefem/core/output_file.hpp"
+#include "simulator/checkpoint_file.hpp"
 #include "integrators/static_solve.hpp"
 #include "simulator/host_views.hpp"
 #include "integrators/time_integrator.hpp"
@@ -46,6 +49,12 @@ struct Simulator<S>::Impl {
         require_finite_vectors(state.fext.read_host(copy), "external_forces");
     }
 
+    // Marks the views' copies stale when it goes (also on an exception).
+    struct Changed {
+        const sim::HostViews<S>& v;
+        ~Changed() { v.changed(); }
+    };
+
     // Runs `call` on the state, one thread at a time (`name` the public
     // call): the written views synced in and checked first, the views'
     // copies stale after (also when it throws).
@@ -54,11 +63,62 @@ struct Simulator<S>::Impl {
         const InUseFlag::Claim claim(in_use, name);
         views.sync();
         check_inputs();
-        struct Changed {
-            const sim::HostViews<S>& v;
-            ~Changed() { v.changed(); }
-        } changed{views};
+        const Changed changed{views};
         return call();
+    }
+
+    sim::Fingerprint fingerprint(const std::string& numbering) const {
+        const Scene& sc = state.scene;
+        sim::Fingerprint p;
+        p.scalar = std::is_same_v<S, float> ? "float" : "double";
+        p.integrator = to_string(sc.integrator);
+        p.solver = sc.solver.linear_solver == LinearSolver::Direct
+                       ? std::string("direct")
+                       : std::string("cg/") + to_string(sc.solver.preconditioner);
+        p.numbering = numbering;
+        p.vertices = std::uint64_t(sc.mesh.num_vertices());
+        p.tets = std::uint64_t(sc.mesh.num_tets());
+        p.mesh_hash = mesh_hash(sc.mesh);
+        p.backend = state.backend->name();
+        return p;
+    }
+    // The state's bytes, in the order apply() reads them.
+    std::string state_bytes() const {
+        sim::CheckpointWriter w;
+        state.save(w);
+        control.save(w);
+        integrator->save(w);
+        solve.save(w);
+        return std::move(w.bytes());
+    }
+    void apply(std::string_view bytes, const std::string& path) {
+        sim::CheckpointReader r(bytes, path);
+        state.load(r);
+        control.load(r);
+        integrator->load(r);
+        solve.load(r);
+        if (!r.done()) r.fail("state", "bytes left over");
+    }
+
+    void save_checkpoint(const std::string& path, const std::string& numbering) {
+        on_state("save_checkpoint", [&] {
+            write_file_atomically(path, sim::checkpoint_file(fingerprint(numbering), state_bytes()));
+        });
+    }
+    // Everything is checked before the state changes; a state that does not
+    // parse after a good checksum (a writer's bug) puts the old one back.
+    void load_checkpoint(const std::string& path, const std::string& numbering) {
+        const InUseFlag::Claim claim(in_use, "load_checkpoint");
+        views.sync();
+        const Changed changed{views};
+        const std::string bytes = sim::read_checkpoint_file(path, fingerprint(numbering));
+        const std::string backup = state_bytes();
+        try {
+            apply(bytes, path);
+        } catch (...) {
+            apply(backup, path);
+            throw;
+        }
     }
 
     Energies energies() {
@@ -148,6 +208,14 @@ std::vector<double> Simulator<S>::positions() const {
     std::vector<double> x(s.n());
     for (std::size_t i = 0; i < x.size(); ++i) x[i] = s.scene.mesh.X[i] + double(u[i]);
     return x;
+}
+template <class S>
+void Simulator<S>::save_checkpoint(const std::string& path, const std::string& numbering) {
+    self().save_checkpoint(path, numbering);
+}
+template <class S>
+void Simulator<S>::load_checkpoint(const std::string& path, const std::string& numbering) {
+    self().load_checkpoint(path, numbering);
 }
 template <class S>
 Energies Simulator<S>::energies() {

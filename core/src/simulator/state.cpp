@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "edgefem/core/coefficients.hpp"
+#include "simulator/checkpoint_stream.hpp"
 #include "simulator/timing.hpp"
 
 namespace edgefem::sim {
@@ -106,6 +107,56 @@ void SimState<S>::history_done(double dt) {
     copy_state(history.v_end, v);
     history.dt = dt;
     history.valid = true;
+}
+
+template <class S>
+void SimState<S>::build_damping_tangent(std::unique_ptr<ElasticOperator<S>>& op_damp) {
+    if (!op_damp) op_damp = backend->make_operator(scene.mesh, scene.materials, scene.model, scene.method);
+    BackendVector<S> scratch = vector<S>(n());
+    op_damp->forces(u.data(), scratch.data(), false);
+    op_damp->build_stiffness(scene.solver.definite_stiffness);
+    if (damping_u.size() != n()) damping_u = vector<S>(n());
+    copy_state(damping_u, u);
+}
+
+template <class S>
+void SimState<S>::save(CheckpointWriter& w) const {
+    w.vector(u);
+    w.vector(v);
+    w.vector(fext);
+    w.vector(f);
+    w.value(step);
+    w.value(time);
+    w.value(ramp_floor);
+    const bool current = history_current();
+    w.value(current);
+    w.value(std::uint64_t(current ? history.vectors.size() : 0));
+    if (current)
+        for (const auto& h : history.vectors) w.vector(h);
+    w.value(history.dt);
+}
+
+template <class S>
+void SimState<S>::load(CheckpointReader& r) {
+    r.vector(u, "displacement");
+    r.vector(v, "velocity");
+    r.vector(fext, "external forces");
+    r.vector(f, "forces");
+    step = r.value<long>("step");
+    time = r.value<double>("time");
+    ramp_floor = r.value<double>("ramp floor");
+    const bool current = r.value<bool>("history flag");
+    const auto count = r.value<std::uint64_t>("history count");
+    if (count > 8) r.fail("history count", std::to_string(count));
+    history.vectors.clear();
+    for (std::uint64_t k = 0; k < count; ++k) {
+        history.vectors.push_back(vector<double>(n()));
+        r.vector(history.vectors.back(), "history vector");
+    }
+    history.dt = r.value<double>("history step size");
+    history.valid = false;
+    if (current) history_done(history.dt);
+    forces_current = false;
 }
 
 template <class S>

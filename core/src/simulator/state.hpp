@@ -13,6 +13,9 @@
 
 namespace edgefem::sim {
 
+class CheckpointWriter;
+class CheckpointReader;
+
 // A failed step, caught to retry with a halved step.
 struct StepFailure {
     std::string message;
@@ -52,6 +55,7 @@ struct SimState {
     BackendVector<double> h;      // external load (external())
     BackendVector<double> b, x;   // the linear solves' right-hand side and solution
     History<S> history;           // the integrator's (integrators/time_integrator.hpp)
+    BackendVector<S> damping_u;   // the u of the last damping tangent K0 (build_damping_tangent)
     StepStats stats;
     long step = 0;
     double time = 0;
@@ -94,6 +98,16 @@ struct SimState {
     bool history_current() const;
     // The history is complete for the current u and v after a step of dt.
     void history_done(double dt);
+
+    // The damping tangent K0 (Rayleigh beta) at u in `op` (made when null),
+    // with the scene's definite_stiffness; u kept as damping_u.
+    void build_damping_tangent(std::unique_ptr<ElasticOperator<S>>& op);
+
+    // The checkpoint's part of the state (checkpoint_stream.hpp): u, v, the
+    // external and the last internal forces, time, step, the ramp's floor and the integrator's
+    // history (kept only when it belongs to u and v).
+    void save(CheckpointWriter& w) const;
+    void load(CheckpointReader& r);
 
     // f at u (timed as force_ms); W when `energy`.
     double forces(bool energy);

@@ -17,6 +17,8 @@ public:
         : s_(state), integrator_(integrator), guard_(state), step_start_u_(state.template vector<S>(0)),
           step_start_v_(state.template vector<S>(0)) {}
     const StepStats& step();
+    void save(CheckpointWriter& w) const { guard_.save(w); }
+    void load(CheckpointReader& r) { guard_.load(r); }
 
 private:
     void advance(double T, int depth);

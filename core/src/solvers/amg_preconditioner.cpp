@@ -14,6 +14,7 @@
 #include "edgefem/core/smoothed_aggregation.hpp"
 #include "solvers/preconditioner.hpp"
 #include "solvers/system_matrix.hpp"
+#include "solvers/tangent_point.hpp"
 
 namespace edgefem::sim {
 
@@ -32,8 +33,14 @@ public:
         const bool due = interval > 0 ? age_ >= interval : stale_ || c != c_;
         if (built_ && !due) return;
         matrix_.assemble(A);
-        if (!built_) amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host);
-        else amg_.refresh(matrix_.projected());
+        if (!built_) {
+            amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host);
+            built_at_.record(s_, A);
+            refreshed_at_.valid = false;
+        } else {
+            amg_.refresh(matrix_.projected());
+            refreshed_at_.record(s_, A);
+        }
         built_ = true;
         c_ = c;
         age_ = 0;
@@ -44,6 +51,38 @@ public:
     void solved(int iterations) override {
         if (fresh_iterations_ < 0) fresh_iterations_ = iterations;
         else if (iterations > 1.5 * fresh_iterations_ + 2) stale_ = true;
+    }
+
+    // The hierarchy and the last refresh are rebuilt from the points they
+    // were made at (the matrices would take ~100x the space).
+    void save(CheckpointWriter& w) const override {
+        w.value(built_);
+        w.value(c_);
+        w.value(age_);
+        w.value(stale_);
+        w.value(fresh_iterations_);
+        built_at_.save(w);
+        refreshed_at_.save(w);
+    }
+    void load(CheckpointReader& r, LinearSystem<S>& A) override {
+        built_ = r.value<bool>("AMG built");
+        c_ = r.value<std::array<double, 3>>("AMG coefficients");
+        age_ = r.value<int>("AMG age");
+        stale_ = r.value<bool>("AMG stale");
+        fresh_iterations_ = r.value<int>("AMG iterations");
+        built_at_.load(r, s_.n());
+        refreshed_at_.load(r, s_.n());
+        if (built_ != built_at_.valid) r.fail("AMG", "built without its point");
+        A_ = &A;
+        if (!built_) return;
+        std::unique_ptr<ElasticOperator<S>> k0;
+        built_at_.rebuild(s_, A, k0);
+        matrix_.assemble(A);
+        amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host);
+        if (!refreshed_at_.valid) return;
+        refreshed_at_.rebuild(s_, A, k0);
+        matrix_.assemble(A);
+        amg_.refresh(matrix_.projected());
     }
 
     bool whole_vector() const override { return true; }
@@ -70,6 +109,7 @@ private:
     int age_ = 0;                // set-ups since the last refresh
     bool stale_ = false;         // the iterations grew: refresh at the next K
     int fresh_iterations_ = -1;  // CG's iterations right after the last refresh
+    TangentPoint<S> built_at_, refreshed_at_;  // where the hierarchy was built and last refreshed (checkpoints)
 };
 
 }  // namespace

@@ -23,6 +23,16 @@ public:
                                       s_.n());
     }
 
+    // A lagged K's (stiffness_interval > 1) set-up serves later steps.
+    void save(CheckpointWriter& w) const override {
+        const bool lagged = s_.scene.solver.stiffness_interval > 1;
+        w.value(lagged);
+        if (lagged) w.vector(Dinv_);
+    }
+    void load(CheckpointReader& r, LinearSystem<S>&) override {
+        if (r.value<bool>("block-Jacobi flag")) r.vector(Dinv_, "block-Jacobi inverses");
+    }
+
     std::size_t bytes() const override { return sizeof(double) * Dinv_.size() + sizeof(S) * (D_.size() + D0_.size()); }
 
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override {

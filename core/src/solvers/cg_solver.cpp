@@ -19,6 +19,8 @@ public:
 
     bool reusable() const override { return true; }
     void setup(LinearSystem<S>& A) override { precond_->setup(A); }
+    void save(CheckpointWriter& w) const override { precond_->save(w); }
+    void load(CheckpointReader& r, LinearSystem<S>& A) override { precond_->load(r, A); }
 
     CgResult solve(LinearSystem<S>& A, BackendVector<double>& b, BackendVector<double>& x, double tolerance,
                    int fixed_iterations) override {

@@ -16,12 +16,16 @@ public:
         : s_(state), Ax_(state.template vector<double>(0)), xs_(state.template vector<S>(0)),
           ys_(state.template vector<S>(0)) {}
 
-    void set(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0) {
+    // `definite`: K was built definite (SolverSettings::definite_stiffness
+    // or the retry on negative curvature), recorded for checkpoints.
+    void set(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, bool definite = false) {
         c_m_ = c_m;
         c_k_ = c_k;
         c_b_ = c_b;
         K0_ = K0;
+        definite_ = definite;
     }
+    bool definite() const { return definite_; }
     double c_m() const { return c_m_; }
     double c_k() const { return c_k_; }
     double c_b() const { return c_b_; }
@@ -41,6 +45,7 @@ private:
     SimState<S>& s_;
     double c_m_ = 0, c_k_ = 0, c_b_ = 0;
     const ElasticOperator<S>* K0_ = nullptr;
+    bool definite_ = false;
     BackendVector<double> Ax_;  // K0 x
     BackendVector<S> xs_, ys_;  // float models: the product's vectors in S
 };

@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "simulator/checkpoint_stream.hpp"
 #include "solvers/linear_system.hpp"
 
 namespace edgefem::sim {
@@ -17,6 +18,10 @@ public:
     // The iterations of the solve it just preconditioned (a lagged set-up
     // decides from them when to refresh).
     virtual void solved(int /*iterations*/) {}
+    // The set-up that may outlive a step, for a checkpoint; load() rebuilds
+    // it (A: the system it preconditions, its coefficients changed).
+    virtual void save(CheckpointWriter& /*w*/) const {}
+    virtual void load(CheckpointReader& /*r*/, LinearSystem<S>& /*A*/) {}
     // Bytes it holds (the memory figures of docs/solvers.md).
     virtual std::size_t bytes() const = 0;
 };

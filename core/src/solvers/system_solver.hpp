@@ -5,6 +5,7 @@
 
 #include <memory>
 
+#include "simulator/checkpoint_stream.hpp"
 #include "solvers/linear_system.hpp"
 
 namespace edgefem::sim {
@@ -20,6 +21,10 @@ public:
     virtual int analyses() const { return 0; }
     // For A with its K just built (preconditioner, factorisation).
     virtual void setup(LinearSystem<S>& A) = 0;
+    // The set-up that may outlive a step, for a checkpoint (the
+    // preconditioner's); load() rebuilds it for A.
+    virtual void save(CheckpointWriter& /*w*/) const {}
+    virtual void load(CheckpointReader& /*r*/, LinearSystem<S>& /*A*/) {}
     // x holds a warm start; `fixed_iterations` > 0: exactly that many
     // iterations (iterative solvers).
     virtual CgResult solve(LinearSystem<S>& A, BackendVector<double>& b, BackendVector<double>& x, double tolerance,

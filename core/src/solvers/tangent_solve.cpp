@@ -25,9 +25,10 @@ CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const E
                                      double tolerance, bool definite, bool reuse_stiffness, int fixed_iterations) {
     auto t0 = Clock::now();
     reuse_stiffness = reuse_stiffness && solver_->reusable();
-    system_.set(c_m, c_k, c_b, K0);
+    system_.set(c_m, c_k, c_b, K0, definite);
     if (!reuse_stiffness) {
         s_.op->build_stiffness(definite);
+        if (s_.scene.solver.stiffness_interval > 1) lagged_.record(s_, system_);
         const int analyses = solver_->analyses();
         solver_->setup(system_);
         s_.stats.symbolic_analyses += solver_->analyses() - analyses;
@@ -38,6 +39,23 @@ CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const E
     s_.stats.solve_ms += ms_since(t0);
     s_.stats.solver_iterations += res.iterations;
     return res;
+}
+
+template <class S>
+void TangentSolve<S>::save(CheckpointWriter& w) const {
+    solver_->save(w);
+    lagged_.save(w);
+}
+
+// The solver's set-up first (the AMG rebuilds K at its points), the lagged
+// K last: it is the one the next step may reuse.
+template <class S>
+void TangentSolve<S>::load(CheckpointReader& r) {
+    solver_->load(r, system_);
+    lagged_.load(r, s_.n());
+    if (!lagged_.valid) return;
+    std::unique_ptr<ElasticOperator<S>> k0;
+    lagged_.rebuild(s_, system_, k0);
 }
 
 template class TangentSolve<double>;

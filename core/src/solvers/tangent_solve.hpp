@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "solvers/system_solver.hpp"
+#include "solvers/tangent_point.hpp"
 
 namespace edgefem::sim {
 
@@ -32,10 +33,16 @@ public:
     CgResult solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
                         bool definite, bool reuse_stiffness = false, int fixed_iterations = 0);
 
+    // For a checkpoint: the solver's set-up that may outlive a step and the
+    // lagged K (stiffness_interval > 1); load() rebuilds them.
+    void save(CheckpointWriter& w) const;
+    void load(CheckpointReader& r);
+
 private:
     SimState<S>& s_;
     LinearSystem<S> system_;
     std::unique_ptr<SystemSolver<S>> solver_;
+    TangentPoint<S> lagged_;  // the last K built, with stiffness_interval > 1
 };
 
 extern template class TangentSolve<double>;

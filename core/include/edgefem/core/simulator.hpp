@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "edgefem/core/backend.hpp"
+#include "edgefem/core/checkpoint.hpp"
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/executor.hpp"
 #include "edgefem/core/scene.hpp"
@@ -109,6 +110,24 @@ public:
     std::span<const double> lumped_mass() const;  // #V
     // Current positions X + u (computed, 3 #V).
     std::vector<double> positions() const;
+
+    // Checkpoints (checkpoint.hpp). save_checkpoint writes the whole state
+    // to `path`, whole or not at all (OutputFile; IoError when it cannot):
+    // u, v, the external forces, time, step index, the integrator's history,
+    // the energy guard's sums and the solver set-ups that outlive a step (a
+    // lagged K, the AMG's hierarchy), the latter as the states they were
+    // built at. load_checkpoint reads it back, rebuilding those set-ups, so
+    // that stepping on continues bit for bit as if the run had not stopped
+    // (on the same back-end and thread-count-independent variants; another
+    // back-end continues from the same state, not with the same bits). It
+    // throws CheckpointError naming the file and the problem (unreadable,
+    // not a checkpoint, truncated, corrupt, or written for another scalar
+    // type, integrator, solver, numbering or mesh) and then leaves the state
+    // as it was. `numbering` labels the vertex numbering the state is in
+    // (OrderedSimulator passes its ordering's name) and must match too. The
+    // scene's other settings (dt, material, loads) are this simulator's.
+    void save_checkpoint(const std::string& path, const std::string& numbering = "");
+    void load_checkpoint(const std::string& path, const std::string& numbering = "");
 
     // Energies of the current state (computes the elastic energy).
     Energies energies();

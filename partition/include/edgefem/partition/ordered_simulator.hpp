@@ -11,6 +11,7 @@
 #pragma once
 
 #include <span>
+#include <string>
 #include <vector>
 
 #include "edgefem/core/in_use_flag.hpp"
@@ -60,6 +61,12 @@ public:
     void set_external_forces(std::span<const double> in);
     std::vector<double> positions() const;
 
+    // Simulator::save_checkpoint / load_checkpoint of the internal
+    // simulator, labelled with the ordering: a checkpoint loads only into a
+    // simulator with the same ordering (its state is in that numbering).
+    void save_checkpoint(const std::string& path);
+    void load_checkpoint(const std::string& path);
+
     Simulator<S>& internal() { return sim_; }
     // Empty for the identity.
     const std::vector<index_t>& new_of_old() const { return new_of_old_; }
@@ -75,6 +82,7 @@ private:
     void pull();
 
     Scene user_scene_;
+    std::string ordering_;  // its name: the checkpoints' numbering
     std::vector<index_t> new_of_old_;
     Simulator<S> sim_;
     std::vector<S> u_, v_, fext_, f_;  // the user-numbered views (empty for the identity)

@@ -1,0 +1,316 @@
+// Checkpoints (edgefem/core/checkpoint.hpp): 2N steps straight and N steps,
+// a checkpoint, a new simulator loading it and N more steps give bitwise the
+// same displacement and velocity, for every integrator, float and double,
+// with damping, prescribed vertices, the lagged K and the AMG refreshed
+// every 2nd K, on the reference back-end and the CPU back-end's pool and
+// OpenMP executors at 2 threads; a checkpoint that cannot be read, or not
+// into this simulator, is a CheckpointError naming the difference and
+// leaves the state unchanged.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "cantilever.hpp"
+#include "edgefem/core/checkpoint.hpp"
+#include "edgefem/core/simulator.hpp"
+#include "edgefem/parallel/run_options.hpp"
+#include "edgefem/partition/ordered_simulator.hpp"
+#include "io_test_util.hpp"
+#include "models.hpp"
+
+namespace edgefem {
+namespace {
+
+using test::bitwise_equal;
+
+constexpr int kHalf = 5;  // steps before and after the checkpoint
+
+
+
+struct Case {
+    std::string name;
+    Integrator integrator;
+    bool damping_and_prescribed = false;
+    int amg_refresh = -1;  // >= 0: AMG with this refresh interval
+    int stiffness_interval = 1;
+};
+
+// 8 x 3 x 3 cubes (144 vertices: the AMG gets one coarse level), clamped at
+// x = min, under gravity.
+Scene case_scene(const Case& c) {
+    Scene s = test::clamped_box_scene(8, 3, 3);
+    s.integrator = c.integrator;
+    s.dt = is_explicit(c.integrator) ? 5e-4 : 2e-3;
+    s.solver.cg_tolerance = 1e-8;
+    s.solver.cg_max_iterations = 2000;
+    if (c.damping_and_prescribed) {
+        s.rayleigh_alpha = 0.5;
+        if (!is_explicit(c.integrator)) s.rayleigh_beta = 2e-3;
+        double xmax = -1;
+        for (index_t v = 0; v < s.mesh.num_vertices(); ++v) xmax = std::max(xmax, s.mesh.X[3 * v]);
+        for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+            if (s.mesh.X[3 * v] > xmax - 1e-9)
+                s.prescribed.push_back({v, {s.mesh.X[3 * v] + 0.004, s.mesh.X[3 * v + 1], s.mesh.X[3 * v + 2] + 0.01}});
+        s.prescribed_steps = 2 * kHalf + 3;  // still ramping at the checkpoint
+    }
+    if (c.amg_refresh >= 0) {
+        s.solver.preconditioner = PreconditionerKind::Amg;
+        s.solver.amg_refresh_interval = c.amg_refresh;
+    }
+    s.solver.stiffness_interval = c.stiffness_interval;
+    return s;
+}
+
+std::vector<Case> cases() {
+    const std::pair<Integrator, const char*> all[] = {
+        {Integrator::Explicit, "explicit"},
+        {Integrator::Verlet, "verlet"},
+        {Integrator::SemiImplicit, "semi_implicit"},
+        {Integrator::Implicit, "implicit"},
+        {Integrator::Newmark, "newmark"},
+        {Integrator::NewmarkLinear, "newmark_linear"},
+        {Integrator::GeneralizedAlpha, "generalized_alpha"},
+        {Integrator::GeneralizedAlphaLinear, "generalized_alpha_linear"},
+        {Integrator::Bdf2, "bdf2"},
+        {Integrator::Bdf2Linear, "bdf2_linear"},
+    };
+    std::vector<Case> out;
+    for (const auto& [integrator, name] : all) {
+        out.push_back({name, integrator});
+        out.push_back({std::string(name) + "_damped_prescribed", integrator, true});
+        if (!is_explicit(integrator)) out.push_back({std::string(name) + "_amg2", integrator, true, 2});
+    }
+    out.push_back({"semi_implicit_lagged3", Integrator::SemiImplicit, true, -1, 3});
+    out.push_back({"semi_implicit_lagged3_amg2", Integrator::SemiImplicit, false, 2, 3});
+    out.push_back({"newmark_linear_amg_lagged", Integrator::NewmarkLinear, false, 0});
+    return out;
+}
+
+template <class S>
+struct State {
+    std::vector<S> u, v;
+    double time;
+    long step;
+};
+
+template <class Sim>
+auto state_of(Sim& sim) {
+    using S = typename std::remove_reference_t<decltype(sim.displacement())>::value_type;
+    const auto u = sim.displacement(), v = sim.velocity();
+    return State<S>{{u.begin(), u.end()}, {v.begin(), v.end()}, sim.time(), sim.step_index()};
+}
+
+template <class S>
+void expect_same(const State<S>& a, const State<S>& b, const std::string& what) {
+    EXPECT_TRUE(bitwise_equal(a.u, b.u)) << what << ": displacement, max rel diff " << test::rel_diff(a.u, b.u);
+    EXPECT_TRUE(bitwise_equal(a.v, b.v)) << what << ": velocity, max rel diff " << test::rel_diff(a.v, b.v);
+    EXPECT_EQ(a.time, b.time) << what;
+    EXPECT_EQ(a.step, b.step) << what;
+}
+
+// make() gives a new simulator of the scene each time.
+template <class Make>
+void check_restart(const Make& make, const std::string& path, const std::string& what) {
+    auto straight = make();
+    for (int k = 0; k < 2 * kHalf; ++k) straight->step();
+    auto first = make();
+    for (int k = 0; k < kHalf; ++k) first->step();
+    first->save_checkpoint(path);
+    auto resumed = make();
+    resumed->load_checkpoint(path);
+    for (int k = 0; k < kHalf; ++k) resumed->step();
+    expect_same(state_of(*straight), state_of(*resumed), what);
+    // The simulator that wrote the checkpoint continues the same way too.
+    for (int k = 0; k < kHalf; ++k) first->step();
+    expect_same(state_of(*straight), state_of(*first), what + " (the writer)");
+}
+
+template <class S>
+class CheckpointRestart : public ::testing::Test {};
+using Scalars = ::testing::Types<double, float>;
+TYPED_TEST_SUITE(CheckpointRestart, Scalars);
+
+TYPED_TEST(CheckpointRestart, ReferenceBackendEveryIntegrator) {
+    using S = TypeParam;
+    test::TempDir dir("ckpt_ref");
+    for (const Case& c : cases()) {
+        const Scene scene = case_scene(c);
+        check_restart([&] { return std::make_unique<Simulator<S>>(scene); }, dir.file(c.name + ".ckpt"), c.name);
+    }
+}
+
+// The program's, the Python module's and the C API's simulator: RCM
+// ordering, the CPU back-end at 2 threads on the pool and OpenMP executors,
+// adaptive (its timing-based choice of loops does not change the bits).
+TYPED_TEST(CheckpointRestart, CpuBackendTwoThreadsEveryIntegrator) {
+    using S = TypeParam;
+    test::TempDir dir("ckpt_cpu");
+    for (const char* executor : {"pool", "omp"}) {
+        RunOptions run;
+        run.backend = executor;
+        run.threads = 2;
+        for (const Case& c : cases()) {
+            const Scene scene = case_scene(c);
+            check_restart([&] { return make_simulator<S>(scene, run); }, dir.file(c.name + ".ckpt"),
+                          std::string(executor) + " " + c.name);
+        }
+    }
+}
+
+// What the checkpoint holds beyond u, v and time matters: a new simulator
+// given only those diverges where the integrator has a history or the
+// solver a set-up that outlives a step (so the tests above can fail), and
+// continues bitwise where neither has one.
+TEST(Checkpoint, HistoryAndSetUpsMatter) {
+    for (const Case& c : {Case{"bdf2", Integrator::Bdf2}, Case{"newmark", Integrator::Newmark},
+                          Case{"lagged", Integrator::SemiImplicit, false, -1, 3},
+                          Case{"amg2", Integrator::SemiImplicit, false, 2},
+                          Case{"memoryless", Integrator::SemiImplicit}}) {
+        const Scene scene = case_scene(c);
+        Simulator<double> straight(scene), copied(scene);
+        for (int k = 0; k < kHalf; ++k) straight.step();
+        std::ranges::copy(straight.displacement(), copied.displacement().begin());
+        std::ranges::copy(straight.velocity(), copied.velocity().begin());
+        for (int k = 0; k < kHalf; ++k) {
+            straight.step();
+            copied.step();
+        }
+        const auto a = state_of(straight), b = state_of(copied);
+        EXPECT_EQ(bitwise_equal(a.u, b.u) && bitwise_equal(a.v, b.v), c.name == "memoryless") << c.name;
+    }
+}
+
+// A scene for the error tests, and a checkpoint of it after 3 steps.
+Scene error_scene(Integrator integrator = Integrator::Bdf2) {
+    Scene s = test::clamped_box_scene(4, 2, 2);
+    s.integrator = integrator;
+    return s;
+}
+
+std::string read_bytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+void write_bytes(const std::string& path, const std::string& bytes) {
+    std::ofstream(path, std::ios::binary) << bytes;
+}
+
+// Loading `path` into `sim` throws CheckpointError whose message contains
+// each of `parts`, and leaves the state as it was.
+template <class Sim>
+void expect_refused(Sim& sim, const std::string& path, const std::vector<std::string>& parts) {
+    const auto before = state_of(sim);
+    try {
+        sim.load_checkpoint(path);
+        ADD_FAILURE() << "loaded " << path;
+    } catch (const CheckpointError& e) {
+        for (const auto& p : parts) EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " / " << p;
+        EXPECT_EQ(e.path(), path);
+    }
+    expect_same(before, state_of(sim), "after a refused load");
+}
+
+TEST(Checkpoint, RefusesAnotherMeshIntegratorScalarOrNumbering) {
+    test::TempDir dir("ckpt_mismatch");
+    const std::string path = dir.file("a.ckpt");
+    Simulator<double> writer(error_scene());
+    for (int k = 0; k < 3; ++k) writer.step();
+    writer.save_checkpoint(path);
+
+    Simulator<double> integ(error_scene(Integrator::Newmark));
+    integ.step();
+    expect_refused(integ, path, {"integrator 'bdf2'", "'newmark'", path});
+
+    Scene bigger = error_scene();
+    bigger.mesh = make_box(5, 2, 2);
+    Simulator<double> mesh(bigger);
+    expect_refused(mesh, path, {"mesh of 45 vertices", "has 54"});
+
+    Scene moved = error_scene();
+    for (double& x : moved.mesh.X) x *= 1.01;
+    Simulator<double> same_size(moved);
+    expect_refused(same_size, path, {"another mesh of the same size"});
+
+    Simulator<float> single(error_scene());
+    expect_refused(single, path, {"scalar type 'double'", "'float'"});
+
+    Scene amg = error_scene();
+    amg.solver.preconditioner = PreconditionerKind::Amg;
+    Simulator<double> solver(amg);
+    expect_refused(solver, path, {"solver 'cg/block-jacobi'", "'cg/amg'"});
+
+    // An OrderedSimulator's state is in its ordering's numbering.
+    RunOptions rcm;
+    rcm.backend = "serial";
+    auto ordered = make_simulator<double>(error_scene(), rcm);
+    expect_refused(*ordered, path, {"vertex numbering ''", "'rcm'"});
+    ordered->save_checkpoint(path);
+    RunOptions morton = rcm;
+    morton.ordering = "morton";
+    auto other = make_simulator<double>(error_scene(), morton);
+    expect_refused(*other, path, {"vertex numbering 'rcm'", "'morton'"});
+}
+
+TEST(Checkpoint, RefusesMissingTruncatedCorruptAndForeignFiles) {
+    test::TempDir dir("ckpt_corrupt");
+    const std::string path = dir.file("a.ckpt");
+    Simulator<double> sim(error_scene());
+    for (int k = 0; k < 3; ++k) sim.step();
+    sim.save_checkpoint(path);
+    const std::string good = read_bytes(path);
+    ASSERT_GT(good.size(), 100u);
+
+    expect_refused(sim, dir.file("missing.ckpt"), {"cannot be opened", "No such file"});
+
+    // Cut anywhere: the header's length says so (or, in the header itself,
+    // it is not a checkpoint).
+    for (const std::size_t keep : {std::size_t(0), std::size_t(10), std::size_t(30), good.size() / 2, good.size() - 1}) {
+        write_bytes(path, good.substr(0, keep));
+        expect_refused(sim, path, {keep < 20 ? "not an edgefem checkpoint" : "truncated"});
+    }
+    write_bytes(path, good + "x");
+    expect_refused(sim, path, {"data appended"});
+
+    // Any byte flipped after the header is caught by the checksum.
+    for (const std::size_t at : {std::size_t(20), std::size_t(40), good.size() / 3, good.size() - 9, good.size() - 1}) {
+        std::string bad = good;
+        bad[at] = char(bad[at] ^ 0x10);
+        write_bytes(path, bad);
+        expect_refused(sim, path, {"corrupt: the checksum does not match"});
+    }
+    std::string version = good;
+    version[8] = 7;
+    write_bytes(path, version);
+    expect_refused(sim, path, {"format version 7"});
+
+    write_bytes(path, "<?xml version=\"1.0\"?> not a checkpoint at all");
+    expect_refused(sim, path, {"not an edgefem checkpoint"});
+    expect_refused(sim, dir.path(), {"checkpoint"});  // a folder
+
+    // The good file still loads after all that.
+    write_bytes(path, good);
+    Simulator<double> fresh(error_scene());
+    fresh.load_checkpoint(path);
+    expect_same(state_of(sim), state_of(fresh), "the good file");
+}
+
+TEST(Checkpoint, WriteFailureIsIoErrorAndKeepsTheOldFile) {
+    test::TempDir dir("ckpt_write");
+    Simulator<double> sim(error_scene());
+    EXPECT_THROW(sim.save_checkpoint(dir.file("no/such/folder/a.ckpt")), IoError);
+    const std::string path = dir.file("a.ckpt");
+    sim.save_checkpoint(path);
+    sim.step();
+    EXPECT_THROW(sim.save_checkpoint(dir.path()), IoError);  // a folder at the name
+    Simulator<double> fresh(error_scene());
+    fresh.load_checkpoint(path);
+    EXPECT_EQ(fresh.step_index(), 0);
+}
+
+}  // namespace
+}  // namespace edgefem
