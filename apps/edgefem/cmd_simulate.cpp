@@ -27,6 +27,9 @@ struct SimulateOptions {
     int steps = -1;     // >= 0 overrides the scene's steps
     std::string integrator;  // non-empty overrides the scene's integrator
     std::string preconditioner;  // non-empty overrides solver.preconditioner
+    std::string checkpoint;      // written every checkpoint_every steps and at the end
+    long checkpoint_every = 0;   // 0: only at the end
+    std::string restart;         // a checkpoint to resume from
     // Its ordering is the internal vertex numbering: RCM by default (the
     // force on bunny-1m runs 2-2.5x faster than in TetGen's numbering:
     // docs/layouts.md, "Orderings: bunny-1m force, 1 thread"); frames and
@@ -101,7 +104,16 @@ void run_simulate(const SimulateOptions& opts) {
                                   make_run_backend<double>(opts.run, executor));
     Simulator<double>& sim = osim.internal();
     const Scene& scene = sf.scene;  // the user's numbering
-    const long steps = scene.steps;
+    // A restart continues the scene's run from the checkpoint's step: the
+    // remaining steps, frames numbered by the step as before.
+    if (!opts.restart.empty()) osim.load_checkpoint(opts.restart);
+    const long first_step = sim.step_index();
+    const long steps = std::max(0L, scene.steps - first_step);
+    const auto save_checkpoint = [&] {
+        check_replaceable(opts.checkpoint, kCheckpointSignature);
+        osim.save_checkpoint(opts.checkpoint);
+    };
+    if (!opts.checkpoint.empty()) check_replaceable(opts.checkpoint, kCheckpointSignature);  // before the run
 
     std::optional<FrameWriter> frames;
     std::optional<PvdSeries> series;
@@ -111,6 +123,17 @@ void run_simulate(const SimulateOptions& opts) {
         const std::string pvd = (std::filesystem::path(out.dir) / (name + ".pvd")).string();
         check_replaceable(pvd, kPvdSignature);
         series.emplace(pvd);
+        // A restart's series lists the frames of the run before it (those
+        // of its output steps that are in the folder), at the times that
+        // run had (its time is summed step by step, as here).
+        double t = 0;
+        for (long s = 0; s <= first_step && first_step > 0; t += scene.dt, ++s) {
+            if (s % out.every != 0 && s != first_step) continue;
+            char frame[64];
+            std::snprintf(frame, sizeof frame, "_%06ld.vtu", s);
+            const std::string path = (std::filesystem::path(out.dir) / (name + frame)).string();
+            if (std::filesystem::is_regular_file(path)) series->add(t, path);
+        }
         // Compaction renumbered the vertices: the map back to the file's numbering.
         if (!sf.file_vertex.empty()) {
             const std::string map = (std::filesystem::path(out.dir) / (name + ".vertex-map")).string();
@@ -150,7 +173,7 @@ void run_simulate(const SimulateOptions& opts) {
     long inverted_steps = 0, first_inverted_step = 0;
     long unconverged_steps = 0;  // CG stopped above its tolerance
     Progress progress(steps);
-    write_frame();
+    if (first_step == 0) write_frame();  // a restart's was written by the run before it
     try {
         for (long s = 1; s <= steps; ++s) {
             const auto t0 = clock::now();
@@ -164,16 +187,22 @@ void run_simulate(const SimulateOptions& opts) {
             inverted_max = std::max(inverted_max, st.inverted_tets);
             if (st.inverted_tets > 0 && inverted_steps++ == 0) first_inverted_step = s;
             unconverged_steps += st.unconverged_solves > 0;
-            if (s % out.every == 0 || s == steps) {
+            const long step = first_step + s;  // the scene's step number
+            if (step % out.every == 0 || s == steps) {
                 write_frame();
                 sample_energy();
             }
+            if (!opts.checkpoint.empty() && opts.checkpoint_every > 0 && step % opts.checkpoint_every == 0 &&
+                s != steps)
+                save_checkpoint();
             progress.update(s, step_ms.back());
         }
     } catch (const SimulationError&) {
         progress.finish();
         throw;
     }
+
+    if (!opts.checkpoint.empty()) save_checkpoint();
 
     // Said once, not per step: a run full of inverted tets looks like a
     // success otherwise (exit 0, one number in the summary).
@@ -191,6 +220,8 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("ordering", opts.run.ordering);
     print_kv("backend", describe(opts.run, executor.get()));
     print_kv("steps", steps);
+    if (first_step > 0) print_kv("restarted_at_step", first_step);
+    if (!opts.checkpoint.empty()) print_kv("checkpoint", opts.checkpoint);
     print_kv("ms_per_step", fmt(median(step_ms), 6));
     print_kv("force_ms", fmt(median(force_ms), 6));
     print_kv("stiffness_ms", fmt(median(stiffness_ms), 6));
@@ -232,10 +263,24 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--preconditioner", opts->preconditioner,
                     "CG's preconditioner: block-jacobi or amg (overrides the scene's solver.preconditioner; "
                     "docs/solvers.md)");
+    cmd->add_option("--checkpoint", opts->checkpoint,
+                    "Write a checkpoint (the whole state, docs/api.md \"Checkpoints\") to this file at the end "
+                    "and every --checkpoint-every steps, replacing the last")
+        ->check(non_empty_path());
+    cmd->add_option("--checkpoint-every", opts->checkpoint_every, "Steps between checkpoints (needs --checkpoint)")
+        ->check(int_in_range(1));
+    cmd->add_option("--restart", opts->restart,
+                    "Resume from a checkpoint of this scene (same integrator, solver and --ordering): steps on "
+                    "from its step to the scene's last, bitwise as if the run had not stopped")
+        ->check(CLI::ExistingFile);
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->run.ordering);
     add_run_options(*cmd, opts->run);
-    cmd->callback([opts] { run_simulate(*opts); });
+    cmd->callback([opts] {
+        if (opts->checkpoint_every > 0 && opts->checkpoint.empty())
+            throw InvalidArgument("--checkpoint-every needs --checkpoint FILE");
+        run_simulate(*opts);
+    });
 }
 
 }  // namespace edgefem::cli

@@ -28,5 +28,7 @@ void check_replaceable(const std::string& path, std::string_view signature);
 inline constexpr std::string_view kVtuSignature = "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\"";
 inline constexpr std::string_view kPvdSignature = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\"";
 inline constexpr std::string_view kVertexMapSignature = "# edgefem vertex map";
+// And the checkpoints' magic (edgefem/core/checkpoint.hpp).
+inline constexpr std::string_view kCheckpointSignature = "EFEMCKPT";
 
 }  // namespace edgefem::cli

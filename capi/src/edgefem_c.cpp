@@ -87,6 +87,23 @@ void require(const void* p, const char* name) {
     if (!p) throw CError{EDGEFEM_ERROR_NULL_POINTER, std::string(name) + " is NULL"};
 }
 
+// A checkpoint call: the file's problems (IoError writing, CheckpointError
+// reading) are EDGEFEM_ERROR_FILE.
+template <class Call>
+edgefem_status checkpoint_call(const char* fn, edgefem_sim* sim, const char* path, Call&& call) {
+    return guard(fn, [&] {
+        require(sim, "sim");
+        require(path, "path");
+        try {
+            call(sim->sim, path);
+        } catch (const edgefem::IoError& e) {
+            throw CError{EDGEFEM_ERROR_FILE, e.what()};
+        } catch (const edgefem::CheckpointError& e) {
+            throw CError{EDGEFEM_ERROR_FILE, e.what()};
+        }
+    });
+}
+
 [[noreturn]] void invalid(std::string message) { throw CError{EDGEFEM_ERROR_INVALID_ARGUMENT, std::move(message)}; }
 
 void require_count(size_t count, size_t expected, const char* name) {
@@ -673,6 +690,16 @@ edgefem_status edgefem_sim_time(const edgefem_sim* sim, double* time, int64_t* s
         if (time) *time = sim->sim.time();
         if (steps) *steps = sim->sim.step_index();
     });
+}
+
+edgefem_status edgefem_sim_save_checkpoint(edgefem_sim* sim, const char* path) {
+    return checkpoint_call("edgefem_sim_save_checkpoint", sim, path,
+                           [](edgefem::OrderedSimulator<double>& s, const char* p) { s.save_checkpoint(p); });
+}
+
+edgefem_status edgefem_sim_load_checkpoint(edgefem_sim* sim, const char* path) {
+    return checkpoint_call("edgefem_sim_load_checkpoint", sim, path,
+                           [](edgefem::OrderedSimulator<double>& s, const char* p) { s.load_checkpoint(p); });
 }
 
 }  // extern "C"

@@ -276,6 +276,7 @@ PYBIND11_MODULE(_edgefem, m) {
     static py::exception<InvalidArgument> invalid(m, "InvalidArgument", error.ptr());
     static py::exception<MeshError> mesh_error(m, "MeshError", error.ptr());
     static py::exception<SimulationError> sim_error(m, "SimulationError", error.ptr());
+    static py::exception<CheckpointError> checkpoint_error(m, "CheckpointError", error.ptr());
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
@@ -283,6 +284,8 @@ PYBIND11_MODULE(_edgefem, m) {
             sim_error(e.what());
         } catch (const MeshError& e) {
             mesh_error(e.what());
+        } catch (const CheckpointError& e) {
+            checkpoint_error(e.what());
         } catch (const InvalidArgument& e) {
             invalid(e.what());
         } catch (const Error& e) {
@@ -578,6 +581,13 @@ PYBIND11_MODULE(_edgefem, m) {
             },
             py::arg("steps"), "step() `steps` times; returns the last step's stats.")
         .def("solve_static", &Sim::solve_static, py::call_guard<py::gil_scoped_release>())
+        .def("save_checkpoint", &Sim::save_checkpoint, py::arg("path"), py::call_guard<py::gil_scoped_release>(),
+             "Writes the whole state to `path`, whole or not at all (docs/api.md, \"Checkpoints\"); raises "
+             "edgefem.Error naming the file when it cannot be written.")
+        .def("load_checkpoint", &Sim::load_checkpoint, py::arg("path"), py::call_guard<py::gil_scoped_release>(),
+             "Reads a checkpoint of this scene, integrator, solver and ordering: stepping on continues bitwise as "
+             "if the run had not stopped. Raises CheckpointError naming the file and the problem (unreadable, "
+             "truncated, corrupt, written for another simulator), the state unchanged.")
         .def("energies", &Sim::energies)
         .def("positions", [](const Sim& s) { return new_vectors(s.positions()); }, "X + u (a new array).")
         .def_property("displacement", vec_view(&Sim::displacement), vec_set(&Sim::displacement, "displacement"))

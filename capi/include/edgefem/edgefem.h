@@ -290,6 +290,21 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_sim_energies(edgefem_sim* sim, edgefem_e
 /** Simulated time (s) and number of steps taken; either may be NULL. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_sim_time(const edgefem_sim* sim, double* time, int64_t* steps);
 
+/** Writes a checkpoint: the simulation's whole state (displacement,
+ *  velocity, external forces, time, step count, the integrator's history and
+ *  the solver set-ups that outlive a step) to `path`, whole or not at all
+ *  (docs/api.md, "Checkpoints"). EDGEFEM_ERROR_FILE naming the file when it
+ *  cannot be written. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_save_checkpoint(edgefem_sim* sim, const char* path);
+/** Reads a checkpoint into a simulation of the same scene (mesh, integrator,
+ *  linear solver and preconditioner) and ordering: stepping on continues bit
+ *  for bit as if the run had not stopped (same run options). A file that
+ *  cannot be read, is not a checkpoint, is truncated or corrupt, or was
+ *  written for another mesh, integrator, solver, ordering or precision is
+ *  EDGEFEM_ERROR_FILE with a message naming the file and the difference; the
+ *  state is then unchanged. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_load_checkpoint(edgefem_sim* sim, const char* path);
+
 #ifdef __cplusplus
 }
 #endif
