@@ -380,6 +380,68 @@ int main(void) {
     /* The simulation still works after all that. */
     CHECK_OK(edgefem_sim_step(sim, NULL));
 
+    /* ---- checkpoints: 3 BDF2 steps, a checkpoint, 3 more steps equal a new
+     * simulation that loads it and takes 3 steps, bit for bit; a missing
+     * file, another integrator and a truncated file are EDGEFEM_ERROR_FILE
+     * and leave the state as it was ---- */
+    {
+        const char* ckpt = "edgefem_test_capi.ckpt";
+        CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_BDF2));
+        edgefem_sim *a = NULL, *b = NULL;
+        CHECK_OK(edgefem_sim_create(scene, &a));
+        CHECK_OK(edgefem_sim_create(scene, &b));
+        for (int k = 0; k < 3; ++k) CHECK_OK(edgefem_sim_step(a, NULL));
+        CHECK_OK(edgefem_sim_save_checkpoint(a, ckpt));
+        for (int k = 0; k < 3; ++k) CHECK_OK(edgefem_sim_step(a, NULL));
+        CHECK_OK(edgefem_sim_load_checkpoint(b, ckpt));
+        for (int k = 0; k < 3; ++k) CHECK_OK(edgefem_sim_step(b, NULL));
+        double* ua = calloc(n3, sizeof(double));
+        double* ub = calloc(n3, sizeof(double));
+        CHECK_OK(edgefem_sim_get_velocity(a, ua, n3));
+        CHECK_OK(edgefem_sim_get_velocity(b, ub, n3));
+        CHECK(memcmp(ua, ub, n3 * sizeof(double)) == 0);
+        CHECK_OK(edgefem_sim_get_displacement(a, ua, n3));
+        CHECK_OK(edgefem_sim_get_displacement(b, ub, n3));
+        CHECK(memcmp(ua, ub, n3 * sizeof(double)) == 0);
+        int64_t sa = 0, sb = 0;
+        CHECK_OK(edgefem_sim_time(a, NULL, &sa));
+        CHECK_OK(edgefem_sim_time(b, NULL, &sb));
+        CHECK(sa == 6 && sb == 6);
+
+        expect_error(edgefem_sim_load_checkpoint(b, "no_such_dir/x.ckpt"), EDGEFEM_ERROR_FILE, "cannot be opened",
+                     "load a missing checkpoint");
+        expect_error(edgefem_sim_load_checkpoint(b, NULL), EDGEFEM_ERROR_NULL_POINTER, "path", "load NULL path");
+        expect_error(edgefem_sim_save_checkpoint(b, "no_such_dir/x.ckpt"), EDGEFEM_ERROR_FILE, "no_such_dir",
+                     "save into a missing folder");
+        CHECK_OK(edgefem_scene_set_integrator(scene, EDGEFEM_NEWMARK));
+        edgefem_sim* other = NULL;
+        CHECK_OK(edgefem_sim_create(scene, &other));
+        expect_error(edgefem_sim_load_checkpoint(other, ckpt), EDGEFEM_ERROR_FILE, "integrator 'bdf2'",
+                     "load into another integrator");
+        /* Keep the first half of the file. */
+        FILE* fp = fopen(ckpt, "rb");
+        CHECK(fp != NULL);
+        if (fp) {
+            char* bytes = malloc(1 << 20);
+            const size_t size = fread(bytes, 1, 1 << 20, fp);
+            fclose(fp);
+            CHECK(size > 100 && size < (1 << 20));
+            fp = fopen(ckpt, "wb");
+            CHECK(fp != NULL && fwrite(bytes, 1, size / 2, fp) == size / 2);
+            if (fp) fclose(fp);
+            free(bytes);
+        }
+        expect_error(edgefem_sim_load_checkpoint(b, ckpt), EDGEFEM_ERROR_FILE, "truncated", "load a truncated file");
+        CHECK_OK(edgefem_sim_get_displacement(b, ub, n3));
+        CHECK(memcmp(ua, ub, n3 * sizeof(double)) == 0);
+        remove(ckpt);
+        free(ua);
+        free(ub);
+        edgefem_sim_destroy(other);
+        edgefem_sim_destroy(a);
+        edgefem_sim_destroy(b);
+    }
+
     edgefem_sim_destroy(sim);
     edgefem_scene_destroy(scene);
     edgefem_scene_destroy(NULL);
