@@ -57,7 +57,13 @@ Fingerprint read_fingerprint(CheckpointReader& r) {
     return p;
 }
 
-std::string quoted(const std::string& s) { return "'" + printable(s) + "'"; }
+// (Appended, not "'" + ... + "'": g++ 12 warns falsely there, -Wrestrict.)
+std::string quoted(const std::string& s) {
+    std::string q(1, '\'');
+    q += printable(s);
+    q += '\'';
+    return q;
+}
 
 }  // namespace
 
