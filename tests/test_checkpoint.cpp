@@ -204,6 +204,14 @@ Scene error_scene(Integrator integrator = Integrator::Bdf2) {
     return s;
 }
 
+// A simulator of error_scene() after 3 steps, its checkpoint written to `path`.
+Simulator<double> checkpointed(const std::string& path) {
+    Simulator<double> sim(error_scene());
+    for (int k = 0; k < 3; ++k) sim.step();
+    sim.save_checkpoint(path);
+    return sim;
+}
+
 std::string read_bytes(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), {}};
@@ -230,9 +238,7 @@ void expect_refused(Sim& sim, const std::string& path, const std::vector<std::st
 TEST(Checkpoint, RefusesAnotherMeshIntegratorScalarOrNumbering) {
     test::TempDir dir("ckpt_mismatch");
     const std::string path = dir.file("a.ckpt");
-    Simulator<double> writer(error_scene());
-    for (int k = 0; k < 3; ++k) writer.step();
-    writer.save_checkpoint(path);
+    checkpointed(path);
 
     Simulator<double> integ(error_scene(Integrator::Newmark));
     integ.step();
@@ -271,9 +277,7 @@ TEST(Checkpoint, RefusesAnotherMeshIntegratorScalarOrNumbering) {
 TEST(Checkpoint, RefusesMissingTruncatedCorruptAndForeignFiles) {
     test::TempDir dir("ckpt_corrupt");
     const std::string path = dir.file("a.ckpt");
-    Simulator<double> sim(error_scene());
-    for (int k = 0; k < 3; ++k) sim.step();
-    sim.save_checkpoint(path);
+    Simulator<double> sim = checkpointed(path);
     const std::string good = read_bytes(path);
     ASSERT_GT(good.size(), 100u);
 
