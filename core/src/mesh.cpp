@@ -28,6 +28,10 @@ std::string Mesh::describe_vertex(index_t v) const {
     return describe("vertex", v, source.vertex_file, source.vertex_line, source.vertex_id);
 }
 
+std::string Mesh::describe_triangle(std::size_t k) const {
+    return describe("triangle", static_cast<index_t>(k), source.triangle_file, source.triangle_line, {});
+}
+
 double signed_volume(const double* a, const double* b, const double* c, const double* d) {
     return physics::tet_signed_volume(a, b, c, d);
 }

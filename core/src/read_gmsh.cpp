@@ -85,6 +85,11 @@ struct GmshData {
     std::vector<int> tet_entity_dim;          // 4.1: dimension of the tet's entity
     std::vector<std::int64_t> tet_entity;     // 4.1: entity tag of the tet's block
     std::unordered_map<std::int64_t, std::int64_t> volume_physical;  // 4.1 $Entities
+    std::unordered_map<std::int64_t, std::int64_t> surface_physical; // 4.1 $Entities
+    std::vector<std::int64_t> tri_nodes;      // 3 node tags per kept triangle
+    std::vector<std::int64_t> tri_tag;        // 2.2: its physical tag; 4.1: its surface entity
+    std::vector<std::int64_t> tri_line;
+    std::map<int, std::string> surface_names;  // $PhysicalNames of dimension 2
     std::map<std::int64_t, std::int64_t> skipped;                      // type -> count
     std::map<std::int64_t, std::int64_t> volume_skipped;               // type -> count: an error
     std::int64_t first_volume_line = 0;                                // of the first volume element skipped
@@ -147,6 +152,42 @@ void add_tet(detail::TextReader& r, GmshData& d, std::int64_t tag, detail::LineT
     d.tet_entity.push_back(entity);
 }
 
+// Nodes of a triangle type kept as a tagged triangle (3, or 6 for the
+// quadratic triangle, corners first), or 0.
+int triangle_node_count(std::int64_t type) { return type == 2 ? 3 : type == 9 ? 6 : 0; }
+
+// Reads a triangle's nodes (the corners kept) to the end of its line.
+void add_triangle(detail::TextReader& r, GmshData& d, std::int64_t tag, detail::LineTokens& tk, int nodes,
+                  std::int64_t surface_tag) {
+    for (int k = 0; k < nodes; ++k) {
+        const std::int64_t node = r.next_int(tk, "triangle node tag");
+        if (k < 3) d.tri_nodes.push_back(node);
+    }
+    r.expect_end(tk, "the " + std::to_string(nodes) + " nodes of triangle " + std::to_string(tag));
+    d.tri_tag.push_back(surface_tag);
+    d.tri_line.push_back(r.line_no());
+}
+
+// $PhysicalNames: 'dim tag "name"' lines; the surfaces' (dim 2) are kept.
+void read_physical_names(detail::TextReader& r, GmshData& d) {
+    const index_t n = r.check_count(single_int(r, "the physical name count"), 3, "physical name");
+    for (index_t i = 0; i < n; ++i) {
+        r.require_line("physical name " + std::to_string(i + 1) + " of " + std::to_string(n));
+        auto tk = r.tokens();
+        const std::int64_t dim = r.next_int(tk, "physical dimension");
+        const std::int64_t tag = r.next_int(tk, "physical tag");
+        const std::string_view line = r.line();
+        const std::size_t open = line.find('"'), close = line.rfind('"');
+        if (open == std::string_view::npos || close == open)
+            r.fail("expected 'dim tag \"name\"', got '" + detail::quote(line) + "'");
+        for (std::size_t k = close + 1; k < line.size(); ++k)
+            if (line[k] != ' ' && line[k] != '\t' && line[k] != '\r')
+                r.fail("unexpected '" + detail::quote(line.substr(k)) + "' after the physical name");
+        if (dim == 2) d.surface_names[region_from_tag(r, tag)] = std::string(line.substr(open + 1, close - open - 1));
+    }
+    expect_line(r, "$EndPhysicalNames", "after " + std::to_string(n) + " physical names");
+}
+
 // Counts `count` skipped elements of `type`; volume elements are kept apart,
 // as they make the mesh unusable.
 void skip_elements(GmshData& d, std::int64_t type, int dim, std::int64_t count, std::int64_t line) {
@@ -187,20 +228,24 @@ void read_elements_22(detail::TextReader& r, GmshData& d) {
             r.fail("bad number of tags " + std::to_string(ntags) + " for element " +
                    std::to_string(tag));
         const int nodes = tet_node_count(type);
+        const int tri_nodes = triangle_node_count(type);
         if (nodes == 0) {
             // MSH 2.2 does not say an element's dimension; only the type does.
             if (element_dimension(type) < 0)
                 r.fail("element type " + std::to_string(type) +
                        " is unknown: cannot tell whether it is a volume element");
             skip_elements(d, type, element_dimension(type), 1, r.line_no());
-            continue;
+            if (tri_nodes == 0) continue;
         }
         std::int64_t physical = 0;
         for (std::int64_t k = 0; k < ntags; ++k) {
             const std::int64_t value = r.next_int(tk, "element tag value");
             if (k == 0) physical = value;
         }
-        add_tet(r, d, tag, tk, nodes, region_from_tag(r, physical), 0, 0);
+        if (tri_nodes)
+            add_triangle(r, d, tag, tk, tri_nodes, region_from_tag(r, physical));
+        else
+            add_tet(r, d, tag, tk, nodes, region_from_tag(r, physical), 0, 0);
     }
     expect_line(r, "$EndElements", "after " + std::to_string(n) + " elements");
 }
@@ -212,8 +257,18 @@ void read_entities_41(detail::TextReader& r, GmshData& d) {
     for (auto& c : counts) c = r.next_int(header, "entity count");
     r.expect_end(header, "the 4 entity counts");
     for (auto& c : counts) c = r.check_count(c, 4, "entity");
-    for (std::int64_t i = 0; i < counts[0] + counts[1] + counts[2]; ++i)
-        r.require_line("a point, curve or surface entity");
+    for (std::int64_t i = 0; i < counts[0] + counts[1]; ++i)
+        r.require_line("a point or curve entity");
+    for (std::int64_t i = 0; i < counts[2]; ++i) {
+        r.require_line("surface entity " + std::to_string(i + 1));
+        auto tk = r.tokens();
+        const std::int64_t tag = r.next_int(tk, "surface tag");
+        for (int k = 0; k < 6; ++k) r.next_double(tk, "bounding box coordinate");
+        const std::int64_t nphys = r.next_int(tk, "number of physical tags");
+        if (nphys < 0 || static_cast<std::size_t>(nphys) > tk.count())
+            r.fail("bad number of physical tags " + std::to_string(nphys));
+        if (nphys > 0) d.surface_physical[tag] = r.next_int(tk, "physical tag");
+    }
     for (std::int64_t i = 0; i < counts[3]; ++i) {
         r.require_line("volume entity " + std::to_string(i + 1));
         auto tk = r.tokens();
@@ -294,16 +349,20 @@ void read_elements_41(detail::TextReader& r, GmshData& d) {
             r.fail("the element blocks hold more elements than the header's count " +
                    std::to_string(n));
         const int nodes = tet_node_count(type);
+        const int tri_nodes = dim == 2 ? triangle_node_count(type) : 0;
         for (index_t i = 0; i < m; ++i) {
             r.require_line("element " + std::to_string(i + 1) + " of block " +
                            std::to_string(b + 1));
             if (nodes == 0) {
                 if (i == 0) skip_elements(d, type, static_cast<int>(dim), m, r.line_no());
-                continue;
+                if (tri_nodes == 0) continue;
             }
             auto et = r.tokens();
             const std::int64_t tag = r.next_int(et, "element tag");
-            add_tet(r, d, tag, et, nodes, 0, static_cast<int>(dim), entity);
+            if (tri_nodes)
+                add_triangle(r, d, tag, et, tri_nodes, entity);
+            else
+                add_tet(r, d, tag, et, nodes, 0, static_cast<int>(dim), entity);
         }
     }
     if (total != n)
@@ -404,6 +463,8 @@ Mesh read_gmsh(const std::string& path, ReadReport* report) {
                 d.version == 2 ? read_elements_22(r, d) : read_elements_41(r, d);
         } else if (name == "Entities" && d.version == 41) {
             read_entities_41(r, d);
+        } else if (name == "PhysicalNames") {
+            read_physical_names(r, d);
         } else if (name.rfind("End", 0) == 0 || name == "MeshFormat" || name.empty()) {
             r.fail("unexpected '" + detail::quote(line) + "'");
         } else {
@@ -443,6 +504,30 @@ Mesh read_gmsh(const std::string& path, ReadReport* report) {
                       static_cast<std::int64_t>(t));
         }
         mesh.tets[i] = v;
+    }
+
+    // Tagged triangles: 4.1 gives their surface entity, whose physical tag
+    // (if any) is the tag.
+    for (std::size_t k = 0; k < d.tri_tag.size(); ++k) {
+        std::int64_t tag = d.tri_tag[k];
+        if (d.version == 41)
+            if (const auto it = d.surface_physical.find(tag); it != d.surface_physical.end()) tag = it->second;
+        if (tag < std::numeric_limits<int>::min() || tag > std::numeric_limits<int>::max())
+            r.fail_at(d.tri_line[k], "surface tag " + std::to_string(tag) + " does not fit an int");
+        mesh.surfaces.tag.push_back(static_cast<int>(tag));
+    }
+    mesh.surfaces.vertices.resize(d.tri_nodes.size());
+    for (std::size_t i = 0; i < d.tri_nodes.size(); ++i) {
+        const index_t v = map.find(d.tri_nodes[i]);
+        if (v < 0)
+            r.fail_at(d.tri_line[i / 3], "triangle " + std::to_string(i / 3) + ": node tag " +
+                                             std::to_string(d.tri_nodes[i]) + " is not defined in $Nodes");
+        mesh.surfaces.vertices[i] = v;
+    }
+    mesh.surfaces.names = std::move(d.surface_names);
+    if (!d.tri_tag.empty()) {
+        src.triangle_file = path;
+        src.triangle_line = std::move(d.tri_line);
     }
 
     for (const auto& [tag, t] : d.mid_nodes)

@@ -101,6 +101,27 @@ void read_tets(detail::TextReader& r, Words& words, int nodes, Mesh& mesh, TetSe
     }
 }
 
+// A Triangles section: item lines 'a b c [reference]' (1-based), kept as
+// the mesh's tagged triangles (resolved at the end, as the tets).
+void read_triangles(detail::TextReader& r, Words& words, std::vector<std::int64_t>& raw, Mesh& mesh) {
+    const index_t n = r.check_count(words.next_int("the triangle count"), 3, "triangle");
+    words.end_of_header("the triangle count");
+    if (std::int64_t(mesh.surfaces.size()) + n > std::numeric_limits<index_t>::max())
+        r.fail("the Triangles sections hold more than 2^31-1 triangles");
+    for (index_t i = 0; i < n; ++i) {
+        r.require_line("triangle " + std::to_string(i + 1) + " of " + std::to_string(n));
+        auto tk = r.tokens();
+        for (int k = 0; k < 3; ++k) raw.push_back(r.next_int(tk, "vertex index"));
+        std::int64_t ref = 0;
+        if (!tk.empty()) ref = r.next_int(tk, "triangle reference");
+        r.expect_end(tk, "triangle " + std::to_string(i + 1));
+        if (ref < std::numeric_limits<int>::min() || ref > std::numeric_limits<int>::max())
+            r.fail("triangle reference " + std::to_string(ref) + " does not fit an int");
+        mesh.surfaces.tag.push_back(static_cast<int>(ref));
+        mesh.source.triangle_line.push_back(r.line_no());
+    }
+}
+
 // Skips a section of `count` item lines. An item line starts with a number,
 // so a keyword where an item should be means the count is too large.
 void skip_items(detail::TextReader& r, const std::string& name, index_t count) {
@@ -175,6 +196,7 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
     std::map<std::string, std::int64_t> skipped, volume;
     std::int64_t first_volume_line = 0;
     std::string previous;  // the last section, for messages
+    std::vector<std::int64_t> triangles;  // 3 vertex numbers per triangle, as read
     for (;;) {
         const std::string_view word = words.next();
         if (word.empty()) break;  // End is optional
@@ -194,6 +216,13 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
             if (seen) r.fail("a second " + previous + " section");
             seen = true;
             read_tets(r, words, kw == "tetrahedra" ? 4 : 10, mesh, tets);
+        } else if (kw == "triangles") {
+            // Kept as tagged triangles; still counted with the elements not simulated.
+            const std::size_t before = mesh.surfaces.size();
+            read_triangles(r, words, triangles, mesh);
+            const auto n = static_cast<std::int64_t>(mesh.surfaces.size() - before);
+            skipped[previous] += n;
+            if (report) report->skipped_elements += n;
         } else {
             const std::int64_t line = r.line_no();
             const std::int64_t count = words.next_int("the item count of section '" + previous + "'");
@@ -215,6 +244,11 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
     if (!have_vertices) r.fail("no Vertices section");
     if (!tets.have_tets && !tets.have_p2) r.fail("no Tetrahedra section");
     mesh.tets = detail::resolve_tets(path, tets.raw, 1, mesh.num_vertices(), src.tet_line, src.tet_id);
+    if (!triangles.empty()) {
+        src.triangle_file = path;
+        mesh.surfaces.vertices =
+            detail::resolve_indices(path, triangles, 3, "triangle", 1, mesh.num_vertices(), src.triangle_line, {});
+    }
     for (const auto& [v, t] : tets.mid)
         if (v < 1 || v > mesh.num_vertices())
             r.fail_at(src.tet_line[t],

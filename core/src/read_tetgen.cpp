@@ -3,6 +3,7 @@
 // indices use that base. Lines must hold exactly the values their header
 // declares, so a wrong header is caught instead of misread.
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -114,7 +115,8 @@ std::int64_t read_node_file(const std::string& file, Mesh& mesh) {
     return base;
 }
 
-void read_ele_file(const std::string& file, std::int64_t base, Mesh& mesh, ReadReport* report) {
+// Returns whether the tets are second order (10 nodes).
+bool read_ele_file(const std::string& file, std::int64_t base, Mesh& mesh, ReadReport* report) {
     detail::TextReader r(file, '#');
     r.require_line("the header line 'T 4 #attributes'");
     auto header = r.tokens();
@@ -161,6 +163,58 @@ void read_ele_file(const std::string& file, std::int64_t base, Mesh& mesh, ReadR
         report->warnings.push_back(
             file + ": 10-node tets: kept the 4 corner nodes; the mid-edge nodes are left "
                    "unreferenced (validate_mesh with compact_unreferenced removes them)");
+    return npt == 10;
+}
+
+// The optional .face file: 'F #markers' then 'id a b c [marker]' lines (6
+// nodes for second-order meshes; two trailing adjacent-tet numbers, as
+// tetgen -nn writes them, are accepted). With boundary markers the faces
+// become the mesh's tagged triangles; without, they carry no tag and are
+// not kept.
+void read_face_file(const std::string& file, std::int64_t base, bool second_order, Mesh& mesh) {
+    detail::TextReader r(file, '#');
+    r.require_line("the header line 'F #markers'");
+    auto header = r.tokens();
+    const std::int64_t n = r.next_int(header, "face count in the header");
+    const std::int64_t nmark = header.empty() ? 0 : r.next_int(header, "boundary marker flag");
+    r.expect_end(header, "the header 'F #markers'");
+    if (nmark != 0 && nmark != 1) r.fail("boundary marker flag must be 0 or 1, got " + std::to_string(nmark));
+    const int nodes = second_order ? 6 : 3;
+    const index_t nf = r.check_count(n, 1 + nodes + int(nmark), "face");
+    std::vector<std::int64_t> raw, lines, ids;
+    std::vector<int> tags;
+    std::int64_t face_base = 0;
+    for (index_t f = 0; f < nf; ++f) {
+        r.require_line("face " + std::to_string(f + 1) + " of " + std::to_string(nf));
+        auto tk = r.tokens();
+        const std::int64_t id = r.next_int(tk, "face number");
+        face_base = check_number(r, id, f, face_base, lines, "face");
+        for (int k = 0; k < nodes; ++k) {
+            const std::int64_t v = r.next_int(tk, "vertex index");
+            if (k < 3) raw.push_back(v);
+            if (k >= 3 && (v < base || v - base >= mesh.num_vertices()))
+                r.fail(detail::item_label("face", f, id) + ": vertex index " + std::to_string(v) + " is out of range", f);
+        }
+        std::int64_t marker = 0;
+        if (nmark) marker = r.next_int(tk, "boundary marker");
+        if (tk.count() == 2) {  // tetgen -nn: the two adjacent tets
+            r.next_int(tk, "adjacent tet");
+            r.next_int(tk, "adjacent tet");
+        }
+        r.expect_end(tk, "the values the header declares for face " + std::to_string(id));
+        if (marker < std::numeric_limits<int>::min() || marker > std::numeric_limits<int>::max())
+            r.fail("boundary marker " + std::to_string(marker) + " does not fit an int");
+        lines.push_back(r.line_no());
+        ids.push_back(id);
+        tags.push_back(static_cast<int>(marker));
+    }
+    if (r.next_line()) r.fail("more face lines than the header's count " + std::to_string(nf));
+    const std::vector<index_t> tri = detail::resolve_indices(file, raw, 3, "face", base, mesh.num_vertices(), lines, ids);
+    if (!nmark) return;
+    mesh.surfaces.vertices = tri;
+    mesh.surfaces.tag = std::move(tags);
+    mesh.source.triangle_file = file;
+    mesh.source.triangle_line = std::move(lines);
 }
 
 }  // namespace
@@ -169,7 +223,13 @@ Mesh read_tetgen(const std::string& path, ReadReport* report) {
     const auto [node, ele] = tetgen_files(path);
     Mesh mesh;
     const std::int64_t base = read_node_file(node, mesh);
-    read_ele_file(ele, base, mesh, report);
+    const bool second_order = read_ele_file(ele, base, mesh, report);
+    // The .face file next to the .node file, when there is one.
+    const std::string prefix = node.substr(0, node.size() - 5);
+    const std::string face = partner(prefix, "face", node.back() == 'E');
+    std::error_code ec;
+    if (iends_with(node, ".node") && std::filesystem::is_regular_file(face, ec))
+        read_face_file(face, base, second_order, mesh);
     return mesh;
 }
 

@@ -146,6 +146,20 @@ void Scene::validate() const {
     check_per_dof("initial.displacement", initial_displacement, nd);
     check_per_dof("initial.velocity", initial_velocity, nd);
     if (!load_keyframes.empty() && load.empty()) bad("load.keyframes", "keyframes without a load");
+    for (std::size_t i = 0; i < surface_loads.size(); ++i) {
+        const SurfaceLoad& sl = surface_loads[i];
+        const std::string field = "surface_loads[" + std::to_string(i) + "]";
+        if (sl.triangles.empty()) bad(field + ".triangles", "no triangles");
+        for (std::size_t k = 0; k < sl.triangles.size(); ++k)
+            for (const index_t v : sl.triangles[k])
+                if (v < 0 || v >= nv)
+                    bad(field + ".triangles[" + std::to_string(k) + "]",
+                        "vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(nv) + " vertices)");
+        if (!std::isfinite(sl.pressure)) bad(field + ".pressure", "non-finite value");
+        for (int r = 0; r < 3; ++r)
+            if (!std::isfinite(sl.traction[r])) bad(field + ".traction", "non-finite component");
+        check_keyframes(field + ".keyframes", sl.keyframes);
+    }
     positive("solver.cg_tolerance", solver.cg_tolerance);
     if (solver.cg_max_iterations < 1) bad("solver.cg_max_iterations", "must be >= 1");
     if (solver.cg_fixed_iterations < 0) bad("solver.cg_fixed_iterations", "must be >= 0");

@@ -18,6 +18,8 @@
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/memory_estimate.hpp"
 #include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/surface.hpp"
+#include "edgefem/core/surface_selection.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "text_reader.hpp"
 
@@ -318,11 +320,42 @@ std::vector<index_t> select_in_box(const Mesh& mesh, const std::array<double, 3>
     return out;
 }
 
-// One "fixed" selector: {"file": PATH} | {"vertices": [...]} | {"box": {...}}.
-void add_fixed(const Context& cx, const json& sel, const std::string& path, const Mesh& mesh,
+// {"min": [x, y, z], "max": [x, y, z]}, each side unbounded when left out.
+std::pair<std::array<double, 3>, std::array<double, 3>> read_box(const Context& cx, const json& box, const std::string& key) {
+    check_keys(cx, box, key, {"min", "max"});
+    std::array<double, 3> lo{-kInf, -kInf, -kInf}, hi{kInf, kInf, kInf};
+    if (const json* m = find(box, "min")) lo = get_vec3(cx, *m, join(key, "min"));
+    if (const json* m = find(box, "max")) hi = get_vec3(cx, *m, join(key, "max"));
+    for (int c = 0; c < 3; ++c)
+        if (lo[c] > hi[c]) cx.fail(key, "min[" + std::to_string(c) + "] = " + num(lo[c]) + " exceeds max[" + std::to_string(c) + "] = " + num(hi[c]));
+    return {lo, hi};
+}
+
+// {"surface": TAG | "NAME"}: the mesh file's triangles with that tag (Gmsh
+// physical surface, TetGen boundary marker, MEDIT reference) or Gmsh
+// physical name, in the file's winding.
+std::vector<Triangle> tagged_surface(const Context& cx, const json& v, const std::string& path, const Mesh& mesh) {
+    if (!v.is_string() && !v.is_number())
+        cx.fail(path, "expected a surface tag (an integer) or a physical name (a string), got " + show(v));
+    const int tag = v.is_number() ? static_cast<int>(get_integer(cx, v, path, std::numeric_limits<int>::min())) : 0;
+    try {
+        return tagged_triangles(mesh, v.is_string() ? tags_named(mesh, v.get<std::string>()) : std::vector<int>{tag});
+    } catch (const InvalidArgument& e) {
+        cx.fail(path, e.what());
+    }
+}
+
+// {"boundary": true}.
+void check_boundary_flag(const Context& cx, const json& v, const std::string& path) {
+    if (!get_bool(cx, v, path)) cx.fail(path, "expected true (the whole boundary), got false");
+}
+
+// One vertex selector ("fixed", "prescribed.select"): {"file": PATH} | {"vertices": [...]} | {"box": {...}}
+// | {"surface": TAG | NAME} | {"boundary": true}.
+void add_selected(const Context& cx, const json& sel, const std::string& path, const Mesh& mesh,
                const Renumbering& renumber, std::vector<index_t>& fixed) {
-    check_keys(cx, sel, path, {"file", "vertices", "box"});
-    if (sel.size() != 1) cx.fail(path, "expected exactly one of \"file\", \"vertices\", \"box\" (use an array of selectors to combine them), got " + show(sel));
+    check_keys(cx, sel, path, {"file", "vertices", "box", "surface", "boundary"});
+    if (sel.size() != 1) cx.fail(path, "expected exactly one of \"file\", \"vertices\", \"box\", \"surface\", \"boundary\" (use an array of selectors to combine them), got " + show(sel));
     const std::size_t before = fixed.size();
     const auto add = [&](index_t v) {
         if (renumber(v) >= 0) fixed.push_back(renumber(v));  // compaction dropped unused vertices
@@ -336,19 +369,62 @@ void add_fixed(const Context& cx, const json& sel, const std::string& path, cons
         for (std::size_t i = 0; i < vs->size(); ++i) {
             add(get_vertex(cx, (*vs)[i], item(key, i), renumber.read_count));
         }
+    } else if (const json* t = find(sel, "surface")) {
+        const std::vector<index_t> in = triangle_vertices(tagged_surface(cx, *t, join(path, "surface"), mesh));
+        fixed.insert(fixed.end(), in.begin(), in.end());
+    } else if (const json* b = find(sel, "boundary")) {
+        check_boundary_flag(cx, *b, join(path, "boundary"));
+        const std::vector<index_t> in = boundary_surface(mesh).vertices();
+        fixed.insert(fixed.end(), in.begin(), in.end());
     } else {
-        const json& box = sel["box"];
-        const std::string key = join(path, "box");
-        check_keys(cx, box, key, {"min", "max"});
-        std::array<double, 3> lo{-kInf, -kInf, -kInf}, hi{kInf, kInf, kInf};
-        if (const json* m = find(box, "min")) lo = get_vec3(cx, *m, join(key, "min"));
-        if (const json* m = find(box, "max")) hi = get_vec3(cx, *m, join(key, "max"));
-        for (int c = 0; c < 3; ++c)
-            if (lo[c] > hi[c]) cx.fail(key, "min[" + std::to_string(c) + "] = " + num(lo[c]) + " exceeds max[" + std::to_string(c) + "] = " + num(hi[c]));
+        const auto [lo, hi] = read_box(cx, sel["box"], join(path, "box"));
         const std::vector<index_t> in = select_in_box(mesh, lo, hi);
         fixed.insert(fixed.end(), in.begin(), in.end());
     }
     if (fixed.size() == before) cx.fail(path, "selects no vertex");
+}
+
+// A selector or a non-empty array of selectors (united): the vertices, ascending.
+std::vector<index_t> select_vertices(const Context& cx, const json& v, const std::string& path, const Mesh& mesh,
+                                     const Renumbering& renumber) {
+    std::vector<index_t> out;
+    if (v.is_array()) {
+        if (v.empty()) cx.fail(path, "expected a selector or a non-empty array of selectors, got []");
+        for (std::size_t i = 0; i < v.size(); ++i) add_selected(cx, v[i], item(path, i), mesh, renumber, out);
+    } else {
+        add_selected(cx, v, path, mesh, renumber, out);
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+// One surface selector of a surface load: {"surface": TAG | NAME} |
+// {"boundary": true} | {"box": {...}} (the boundary triangles whose three
+// vertices lie in it); the triangles wound outward.
+void add_surface(const Context& cx, const json& sel, const std::string& path, const Mesh& mesh,
+                 std::vector<Triangle>& out) {
+    check_keys(cx, sel, path, {"surface", "boundary", "box"});
+    if (sel.size() != 1)
+        cx.fail(path, "expected exactly one of \"surface\", \"boundary\", \"box\" (use an array of selectors to combine them), got " + show(sel));
+    std::vector<Triangle> tri;
+    if (const json* t = find(sel, "surface")) {
+        const std::string key = join(path, "surface");
+        const std::vector<Triangle> tagged = tagged_surface(cx, *t, key, mesh);
+        try {
+            tri = orient_outward(mesh, tagged);
+        } catch (const MeshError& e) {
+            cx.fail(key, e.what());
+        }
+    } else if (const json* b = find(sel, "boundary")) {
+        check_boundary_flag(cx, *b, join(path, "boundary"));
+        tri = boundary_surface(mesh).triangles;
+    } else {
+        const auto [lo, hi] = read_box(cx, sel["box"], join(path, "box"));
+        tri = boundary_in_box(mesh, lo, hi);
+        if (tri.empty()) cx.fail(join(path, "box"), "selects no boundary triangle (all three vertices must lie in the box)");
+    }
+    out.insert(out.end(), tri.begin(), tri.end());
 }
 
 // ---- The scene ---------------------------------------------------------
@@ -435,17 +511,31 @@ std::vector<double> read_vertex_vectors(const Context& cx, const std::string& ke
 
 void read_prescribed(const Context& cx, const json& v, const Renumbering& renumber, Scene& scene) {
     const std::string p = "prescribed";
-    check_keys(cx, v, p, {"file", "steps", "keyframes"});
+    check_keys(cx, v, p, {"file", "select", "displacement", "steps", "keyframes"});
     const json* f = find(v, "file");
-    if (!f) cx.fail(join(p, "file"), "required key missing");
-    const std::string key = join(p, "file");
-    const std::string file = get_string(cx, *f, key);
-    std::map<index_t, std::int64_t> seen;  // vertex -> line
-    for (const IndexLine& l : read_index_file(cx, key, file, 3, renumber.read_count)) {
-        if (const auto [it, fresh] = seen.emplace(l.vertex, l.line); !fresh)
-            cx.fail(key, cx.resolve(file) + ":" + std::to_string(l.line) + ": vertex " + std::to_string(l.vertex) +
-                             " already prescribed on line " + std::to_string(it->second));
-        if (renumber(l.vertex) >= 0) scene.prescribed.push_back({renumber(l.vertex), l.xyz});
+    const json* sel = find(v, "select");
+    const json* d = find(v, "displacement");
+    if (!f && !sel) cx.fail(p, "expected \"file\" (targets per vertex) or \"select\" with \"displacement\"");
+    if (sel && !d) cx.fail(join(p, "displacement"), "required key missing (with \"select\")");
+    if (d && !sel) cx.fail(join(p, "displacement"), "applies only to the vertices of \"select\"");
+    if (f) {
+        const std::string key = join(p, "file");
+        const std::string file = get_string(cx, *f, key);
+        std::map<index_t, std::int64_t> seen;  // vertex -> line
+        for (const IndexLine& l : read_index_file(cx, key, file, 3, renumber.read_count)) {
+            if (const auto [it, fresh] = seen.emplace(l.vertex, l.line); !fresh)
+                cx.fail(key, cx.resolve(file) + ":" + std::to_string(l.line) + ": vertex " + std::to_string(l.vertex) +
+                                 " already prescribed on line " + std::to_string(it->second));
+            if (renumber(l.vertex) >= 0) scene.prescribed.push_back({renumber(l.vertex), l.xyz});
+        }
+    }
+    if (sel) {
+        // Every selected vertex moves by the same displacement (m).
+        const std::array<double, 3> u = get_vec3(cx, *d, join(p, "displacement"));
+        for (const index_t vtx : select_vertices(cx, *sel, join(p, "select"), scene.mesh, renumber)) {
+            const double* X = &scene.mesh.X[3 * std::size_t(vtx)];
+            scene.prescribed.push_back({vtx, {X[0] + u[0], X[1] + u[1], X[2] + u[2]}});
+        }
     }
     if (const json* s = find(v, "steps")) scene.prescribed_steps = get_int(cx, *s, join(p, "steps"), 1);
     if (const json* k = find(v, "keyframes")) scene.prescribed_keyframes = read_keyframes(cx, *k, join(p, "keyframes"));
@@ -458,6 +548,42 @@ void read_load(const Context& cx, const json& v, const Renumbering& renumber, Sc
     if (!f) cx.fail("load.file", "required key missing");
     scene.load = read_vertex_vectors(cx, "load.file", get_string(cx, *f, "load.file"), renumber, scene.mesh);
     if (const json* k = find(v, "keyframes")) scene.load_keyframes = read_keyframes(cx, *k, "load.keyframes");
+}
+
+// "surface_loads": [{"on": SELECTOR | [SELECTOR, ...], "pressure": p,
+// "traction": [tx, ty, tz], "keyframes": [...]}, ...].
+void read_surface_loads(const Context& cx, const json& v, Scene& scene) {
+    const std::string p = "surface_loads";
+    if (!v.is_array() || v.empty()) cx.fail(p, "expected a non-empty array of surface loads, got " + show(v));
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        const std::string key = item(p, i);
+        const json& e = v[i];
+        check_keys(cx, e, key, {"on", "pressure", "traction", "keyframes"});
+        const json* on = find(e, "on");
+        if (!on) cx.fail(join(key, "on"), "required key missing");
+        const json* pr = find(e, "pressure");
+        const json* tr = find(e, "traction");
+        if (!pr && !tr) cx.fail(key, "expected \"pressure\" or \"traction\" (or both)");
+        SurfaceLoad load;
+        std::vector<Triangle> tri;
+        if (on->is_array()) {
+            if (on->empty()) cx.fail(join(key, "on"), "expected a selector or a non-empty array of selectors, got []");
+            for (std::size_t k = 0; k < on->size(); ++k) add_surface(cx, (*on)[k], item(join(key, "on"), k), scene.mesh, tri);
+        } else {
+            add_surface(cx, *on, join(key, "on"), scene.mesh, tri);
+        }
+        // Selectors unite: a triangle selected twice is loaded once.
+        std::set<std::array<index_t, 3>> seen;
+        for (const Triangle& t : tri) {
+            std::array<index_t, 3> k = t;
+            std::sort(k.begin(), k.end());
+            if (seen.insert(k).second) load.triangles.push_back(t);
+        }
+        if (pr) load.pressure = get_number(cx, *pr, join(key, "pressure"));
+        if (tr) load.traction = get_vec3(cx, *tr, join(key, "traction"));
+        if (const json* k = find(e, "keyframes")) load.keyframes = read_keyframes(cx, *k, join(key, "keyframes"));
+        scene.surface_loads.push_back(std::move(load));
+    }
 }
 
 // "initial": {"displacement": {"file": PATH}, "velocity": [vx, vy, vz] |
@@ -507,7 +633,7 @@ SceneFile parse(const Context& cx, const json& root) {
     if (!root.is_object()) throw InvalidArgument(cx.source + ": expected a JSON object at the top level, got " + show(root));
     check_keys(cx, root, "",
                {"mesh", "mesh_options", "material", "regions", "model", "method", "gravity", "damping", "fixed",
-                "prescribed", "load", "initial", "integrator", "newmark", "generalized_alpha", "dt", "steps", "solver",
+                "prescribed", "load", "surface_loads", "initial", "integrator", "newmark", "generalized_alpha", "dt", "steps", "solver",
                 "output"});
     SceneFile sf;
     Scene& s = sf.scene;
@@ -587,19 +713,10 @@ SceneFile parse(const Context& cx, const json& root) {
         if (const json* a = find(*x, "alpha")) s.rayleigh_alpha = get_number(cx, *a, "damping.alpha", Range::NonNegative);
         if (const json* b = find(*x, "beta")) s.rayleigh_beta = get_number(cx, *b, "damping.beta", Range::NonNegative);
     }
-    if (const json* x = find(root, "fixed")) {
-        if (x->is_array()) {
-            if (x->empty()) cx.fail("fixed", "expected a selector or a non-empty array of selectors, got []");
-            for (std::size_t i = 0; i < x->size(); ++i) add_fixed(cx, (*x)[i], item("fixed", i), s.mesh, renumber, s.fixed);
-        } else {
-            add_fixed(cx, *x, "fixed", s.mesh, renumber, s.fixed);
-        }
-        // Selectors unite.
-        std::sort(s.fixed.begin(), s.fixed.end());
-        s.fixed.erase(std::unique(s.fixed.begin(), s.fixed.end()), s.fixed.end());
-    }
+    if (const json* x = find(root, "fixed")) s.fixed = select_vertices(cx, *x, "fixed", s.mesh, renumber);
     if (const json* x = find(root, "prescribed")) read_prescribed(cx, *x, renumber, s);
     if (const json* x = find(root, "load")) read_load(cx, *x, renumber, s);
+    if (const json* x = find(root, "surface_loads")) read_surface_loads(cx, *x, s);
     if (const json* x = find(root, "initial")) read_initial(cx, *x, renumber, s);
     if (const json* x = find(root, "integrator"))
         s.integrator = get_enum<Integrator>(cx, *x, "integrator", integrator_names());

@@ -201,28 +201,35 @@ void check_finite(const TextReader& reader, const double* xyz, index_t vertex,
     reader.fail(item_label("vertex", vertex, file_id) + buffer, vertex);
 }
 
-std::vector<index_t> resolve_tets(const std::string& file, const std::vector<std::int64_t>& raw,
-                                  std::int64_t base, index_t nv,
-                                  const std::vector<std::int64_t>& tet_line,
-                                  const std::vector<std::int64_t>& tet_id) {
-    std::vector<index_t> tets(raw.size());
+std::vector<index_t> resolve_indices(const std::string& file, const std::vector<std::int64_t>& raw, int per_item,
+                                     const char* kind, std::int64_t base, index_t nv,
+                                     const std::vector<std::int64_t>& line, const std::vector<std::int64_t>& id) {
+    std::vector<index_t> out(raw.size());
     for (std::size_t i = 0; i < raw.size(); ++i) {
         const std::int64_t v = raw[i] - base;
         if (raw[i] >= base && v < nv) {
-            tets[i] = static_cast<index_t>(v);
+            out[i] = static_cast<index_t>(v);
             continue;
         }
-        const std::size_t t = i / 4;
+        const std::size_t t = i / per_item;
         const std::string range =
             nv == 0 ? "the file has no vertices"
                     : "vertices are numbered " + std::to_string(base) + ".." +
                           std::to_string(base + nv - 1);
-        throw MeshError(item_label("tet", static_cast<std::int64_t>(t), tet_id[t]) +
+        const std::int64_t file_id = t < id.size() ? id[t] : static_cast<std::int64_t>(t);
+        throw MeshError(item_label(kind, static_cast<std::int64_t>(t), file_id) +
                             ": vertex index " + std::to_string(raw[i]) + " is out of range (" +
                             range + ")",
-                        file, tet_line[t], static_cast<std::int64_t>(t));
+                        file, line[t], static_cast<std::int64_t>(t));
     }
-    return tets;
+    return out;
+}
+
+std::vector<index_t> resolve_tets(const std::string& file, const std::vector<std::int64_t>& raw,
+                                  std::int64_t base, index_t nv,
+                                  const std::vector<std::int64_t>& tet_line,
+                                  const std::vector<std::int64_t>& tet_id) {
+    return resolve_indices(file, raw, 4, "tet", base, nv, tet_line, tet_id);
 }
 
 int region_from_attribute(const TextReader& reader, double value) {

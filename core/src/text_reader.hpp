@@ -116,6 +116,12 @@ std::vector<index_t> resolve_tets(const std::string& file, const std::vector<std
                                   const std::vector<std::int64_t>& tet_line,
                                   const std::vector<std::int64_t>& tet_id);
 
+// The same for any item of `per_item` vertices ("triangle"); `id` may be
+// empty (the items are then numbered by their index).
+std::vector<index_t> resolve_indices(const std::string& file, const std::vector<std::int64_t>& raw, int per_item,
+                                     const char* kind, std::int64_t base, index_t nv,
+                                     const std::vector<std::int64_t>& line, const std::vector<std::int64_t>& id);
+
 // A region attribute as an int, failing (naming the file and line) when it
 // is not a finite integer (to 1e-6 relative: float round-off) that fits an int.
 int region_from_attribute(const TextReader& reader, double value);

@@ -49,6 +49,31 @@ void check_structure(const Mesh& mesh) {
         throw MeshError("mesh has " + std::to_string(mesh.region.size()) + " region ids for " +
                             std::to_string(mesh.num_tets()) + " tets",
                         src.tet_file);
+    const TaggedTriangles& tri = mesh.surfaces;
+    if (tri.vertices.size() != 3 * tri.tag.size())
+        throw MeshError("mesh has " + std::to_string(tri.vertices.size()) + " tagged-triangle indices for " +
+                            std::to_string(tri.tag.size()) + " tags (expected 3 per triangle)",
+                        src.triangle_file);
+}
+
+// The tagged triangles' indices: in range, three distinct vertices.
+void check_triangle_indices(const Mesh& mesh) {
+    const index_t nv = mesh.num_vertices();
+    const TaggedTriangles& tri = mesh.surfaces;
+    for (std::size_t k = 0; k < tri.size(); ++k) {
+        const index_t* v = &tri.vertices[3 * k];
+        for (int i = 0; i < 3; ++i) {
+            if (v[i] < 0 || v[i] >= nv)
+                throw MeshError(mesh.describe_triangle(k) + ": vertex index " + std::to_string(v[i]) +
+                                    " is out of range (the mesh has " + std::to_string(nv) + " vertices)",
+                                {}, 0, static_cast<std::int64_t>(k));
+            for (int j = 0; j < i; ++j)
+                if (v[j] == v[i])
+                    throw MeshError(mesh.describe_triangle(k) + " is degenerate: it uses vertex " +
+                                        file_vertex(mesh, v[i]) + " twice",
+                                    {}, 0, static_cast<std::int64_t>(k));
+        }
+    }
 }
 
 void check_indices(const Mesh& mesh) {
@@ -169,6 +194,30 @@ void handle_unreferenced(Mesh& mesh, const ValidationOptions& options, Validatio
     if (ids) src.vertex_id.resize(next);
     for (index_t& v : mesh.tets) v = renumber[v];
     report.removed_vertices = unused;
+    // Tagged triangles follow; one that uses a removed vertex bounds no tet
+    // and is dropped.
+    TaggedTriangles& tri = mesh.surfaces;
+    const bool tri_lines = src.triangle_line.size() == tri.size();
+    std::size_t kept = 0, dropped = 0;
+    std::string first_dropped;
+    for (std::size_t k = 0; k < tri.size(); ++k) {
+        const index_t* v = &tri.vertices[3 * k];
+        if (renumber[v[0]] < 0 || renumber[v[1]] < 0 || renumber[v[2]] < 0) {
+            if (dropped++ == 0) first_dropped = mesh.describe_triangle(k);
+            continue;
+        }
+        for (int i = 0; i < 3; ++i) tri.vertices[3 * kept + i] = renumber[v[i]];
+        tri.tag[kept] = tri.tag[k];
+        if (tri_lines) src.triangle_line[kept] = src.triangle_line[k];
+        ++kept;
+    }
+    if (dropped > 0)
+        report.warnings.push_back("dropped " + std::to_string(dropped) +
+                                  " tagged triangles that use a removed vertex (the first is " +
+                                  first_dropped + ")");
+    tri.vertices.resize(3 * kept);
+    tri.tag.resize(kept);
+    if (tri_lines) src.triangle_line.resize(kept);
 }
 
 // Every check that needs no change to the mesh; returns the negatively
@@ -176,6 +225,7 @@ void handle_unreferenced(Mesh& mesh, const ValidationOptions& options, Validatio
 std::vector<index_t> check_all_but_orientation(const Mesh& mesh, const ValidationOptions& options) {
     check_structure(mesh);
     check_indices(mesh);
+    check_triangle_indices(mesh);
     check_finite(mesh);
 
     // One pass for degenerate and inverted tets; degenerate ones are reported

@@ -15,6 +15,9 @@ Scene permute_scene(const Scene& scene, const std::vector<index_t>& new_of_old) 
     s.mesh = permute_mesh(scene.mesh, new_of_old);
     for (index_t& v : s.fixed) v = new_of_old.at(v);
     for (auto& p : s.prescribed) p.vertex = new_of_old.at(p.vertex);
+    for (SurfaceLoad& l : s.surface_loads)
+        for (auto& t : l.triangles)
+            for (index_t& v : t) v = new_of_old.at(v);
     // Per-vertex vectors (3 #V) follow their vertices.
     for (std::vector<double>* x : {&s.load, &s.initial_displacement, &s.initial_velocity}) {
         if (x->size() != 3 * new_of_old.size()) continue;  // empty (or wrong: validate() names it)

@@ -41,6 +41,11 @@ Mesh permute_mesh(const Mesh& mesh, const std::vector<index_t>& new_of_old) {
     const MeshSource& src = mesh.source;
     out.source.vertex_file = src.vertex_file;
     out.source.tet_file = src.tet_file;
+    // Tagged triangles keep their order; their vertices are renamed.
+    out.surfaces = mesh.surfaces;
+    for (index_t& v : out.surfaces.vertices) v = new_of_old.at(v);
+    out.source.triangle_file = src.triangle_file;
+    out.source.triangle_line = src.triangle_line;
     auto permute_vertex_info = [&](const std::vector<std::int64_t>& in, std::vector<std::int64_t>& o) {
         if (in.size() != std::size_t(nv)) return;
         o.resize(nv);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/surface_load.hpp"
 #include "simulator/checkpoint_stream.hpp"
 #include "simulator/timing.hpp"
 
@@ -53,9 +54,23 @@ SimState<S>::SimState(Scene s, std::shared_ptr<const Backend<S>> back)
     h = vector<double>(nd);
     x = vector<double>(nd);
     b = vector<double>(nd);
-    scene_load = vector<double>(scene.load.empty() ? 0 : nd);
+    // Loads with the same keyframes are one group (the usual case: one).
+    const auto group = [&](const std::vector<Keyframe>& keys) -> std::vector<double>& {
+        for (LoadGroup& g : load_groups)
+            if (std::equal(g.keys.begin(), g.keys.end(), keys.begin(), keys.end(),
+                           [](const Keyframe& a, const Keyframe& b) { return a.time == b.time && a.value == b.value; }))
+                return g.force;
+        load_groups.push_back({keys, std::vector<double>(nd, 0.0)});
+        return load_groups.back().force;
+    };
     if (!scene.load.empty()) {
-        scene_load.write(scene.load);
+        std::vector<double>& f = group(scene.load_keyframes);
+        for (std::size_t i = 0; i < nd; ++i) f[i] += scene.load[i];
+    }
+    for (const SurfaceLoad& sl : scene.surface_loads) add_surface_load_forces(mesh.X, sl, 1.0, group(sl.keyframes));
+    scene_load = vector<double>(load_groups.empty() ? 0 : nd);
+    if (!load_groups.empty()) {
+        if (load_groups.size() == 1) scene_load.write(load_groups[0].force);
         fext_step = vector<S>(nd);
     }
     const auto initial = [&](BackendVector<S>& dst, const std::vector<double>& src) {
@@ -169,8 +184,18 @@ void SimState<S>::update_load(double t) {
     if (!scene_load.size()) return;
     b.resize(n());
     kernels.from_state(b.data(), fext.data(), n());  // b: scratch until the step's solve writes it
-    kernels.line_search_point(fext_step.data(), b.data(), scene_load.data(), keyframe_value(scene.load_keyframes, t),
-                              n());
+    double scale = 1;
+    if (load_groups.size() == 1) {
+        scale = keyframe_value(load_groups[0].keys, t);
+    } else {  // several keyframe sets: their sum at t, on the host
+        std::vector<double> sum(n(), 0.0);
+        for (const LoadGroup& g : load_groups) {
+            const double s = keyframe_value(g.keys, t);
+            for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += s * g.force[i];
+        }
+        scene_load.write(sum);
+    }
+    kernels.line_search_point(fext_step.data(), b.data(), scene_load.data(), scale, n());
 }
 
 template <class S>

@@ -50,7 +50,14 @@ struct SimState {
     BackendVector<double> con_disp;         // their final displacement (3 each)
     double ramp_floor = 0;                  // 1 after solve_static: the prescribed targets are reached
     bool forces_current = false;  // f is at the step's starting u: the step skips its force pass
-    BackendVector<double> scene_load;  // scene.load (3 #V; empty: none)
+    // The scene's loads (scene.load and the surface loads' nodal forces),
+    // grouped by keyframes: the sum of each group's vector x its s(t).
+    struct LoadGroup {
+        std::vector<Keyframe> keys;
+        std::vector<double> force;  // 3 #V
+    };
+    std::vector<LoadGroup> load_groups;
+    BackendVector<double> scene_load;  // one group's force, or all groups' at the last time (3 #V; empty: none)
     BackendVector<S> fext_step;        // with a scene load: f_ext + its keyframed value over the step
     BackendVector<double> h;      // external load (external())
     BackendVector<double> b, x;   // the linear solves' right-hand side and solution

@@ -37,12 +37,16 @@ struct ReadReport {
 // then drop them), and fails on any other volume element
 // (hexahedra, prisms, pyramids, ...): simulating the tets alone would drop
 // part of the body. Point, line and surface elements are boundary markup:
-// they are skipped and counted in ReadReport.
+// they are not simulated and are counted in ReadReport; tagged triangles
+// are also kept as Mesh::surfaces (Gmsh triangles with their physical tag
+// and $PhysicalNames, MEDIT Triangles with their reference, the TetGen
+// .face file's boundary markers), for selections and surface loads.
 
 // TetGen .node/.ele: `path` is the .node file, the .ele file (extensions in
 // either case) or their common prefix. 0- or 1-based numbering, '#' comments,
 // attributes and boundary markers are accepted; the first tet attribute, if
-// any, becomes the region.
+// any, becomes the region. A .face file next to the .node file is read too:
+// with boundary markers its faces become the tagged triangles.
 Mesh read_tetgen(const std::string& path, ReadReport* report = nullptr);
 // Gmsh MSH 2.2 and 4.1 ASCII: tetrahedra (types 4, 11, 29, 30, 31); the
 // physical tag becomes the region.

@@ -118,6 +118,22 @@ struct Prescribed {
     std::array<double, 3> target;
 };
 
+// A pressure and a traction on a surface, dead loads on the rest
+// configuration: the force of each triangle is computed once from its rest
+// area and normal (it does not turn or grow with the deformed surface) and
+// given to its three vertices in equal thirds (exact for a constant load on
+// linear triangles). docs/scenes.md, "Surface loads".
+struct SurfaceLoad {
+    // Triangles wound so that (b - a) x (c - a) points out of the body
+    // (select_surface's and boundary_surface's winding); mesh vertices.
+    std::vector<std::array<index_t, 3>> triangles;
+    // Pa, along the inward normal: a positive pressure pushes into the body
+    // (force -p n A per triangle, n the outward unit normal, A its area).
+    double pressure = 0;
+    std::array<double, 3> traction{0, 0, 0};  // Pa: force per rest area, a fixed vector
+    std::vector<Keyframe> keyframes;          // scale s(t), as load_keyframes (empty: 1)
+};
+
 struct Scene {
     Mesh mesh;
     Materials materials;
@@ -138,6 +154,9 @@ struct Scene {
     // Simulator::external_forces().
     std::vector<double> load;
     std::vector<Keyframe> load_keyframes;
+    // Pressure and traction on surfaces, each with its own keyframes; added
+    // to the external force like `load`.
+    std::vector<SurfaceLoad> surface_loads;
     // The initial state (3 #V each; empty: at rest).
     std::vector<double> initial_displacement, initial_velocity;
     Integrator integrator = Integrator::SemiImplicit;
