@@ -4,6 +4,7 @@
 // boundary.
 #include "edgefem/edgefem.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/surface.hpp"
+#include "edgefem/core/surface_selection.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/parallel/run_options.hpp"
 
@@ -165,19 +167,41 @@ edgefem::Scene default_scene_for(edgefem::Mesh mesh) {
     return s;
 }
 
+// The mesh options of edgefem_scene_create_from_mesh_file_with (0 or 1 each).
+struct MeshFlags {
+    int32_t fix_orientation = 0, compact = 0;
+    bool offered = false;  // whether the caller could have set them
+};
+
 edgefem_status make_scene(const char* fn, edgefem_scene** out, edgefem::Mesh (*build)(const void*),
-                          const void* ctx, edgefem_status invalid_status = EDGEFEM_ERROR_INVALID_ARGUMENT) {
+                          const void* ctx, MeshFlags flags = {}) {
     if (out) *out = nullptr;
     return guard(fn, [&] {
         require(out, "out");
+        if (flags.fix_orientation != 0 && flags.fix_orientation != 1)
+            invalid("fix_orientation: " + std::to_string(flags.fix_orientation) + " (expected 0 or 1)");
+        if (flags.compact != 0 && flags.compact != 1)
+            invalid("compact: " + std::to_string(flags.compact) + " (expected 0 or 1)");
         edgefem::Mesh mesh = build(ctx);
-        // The C API has neither option: its messages must not suggest them.
         edgefem::ValidationOptions options;
-        options.fix_orientation_hint = "reorder their vertices before passing the mesh (the C API does not reorient)";
-        options.compact_hint = "leave them out of the arrays passed";
+        options.fix_orientation = flags.fix_orientation == 1;
+        options.compact_unreferenced = flags.compact == 1;
+        // Messages name only the options the caller has.
+        options.fix_orientation_hint = flags.offered ? "pass fix_orientation = 1 (edgefem_scene_create_from_mesh_file_with)"
+                                                     : "reorder their vertices before passing the mesh (or use edgefem_scene_create_from_mesh_file_with)";
+        options.compact_hint = flags.offered ? "pass compact = 1 (edgefem_scene_create_from_mesh_file_with)"
+                                             : "leave them out (or use edgefem_scene_create_from_mesh_file_with with compact = 1)";
         edgefem::validate_mesh(mesh, options);
         *out = new_handle<edgefem_scene>(edgefem_scene{default_scene_for(std::move(mesh))});
-    }, invalid_status);
+    });
+}
+
+// A mesh file or "box:NXxNYxNZ" spec.
+edgefem::Mesh mesh_from_path(const void* p) {
+    const char* path = static_cast<const char*>(p);
+    require(path, "path");
+    const std::string s(path);
+    return edgefem::is_box_spec(s) ? edgefem::make_box_from_spec(s) : edgefem::read_mesh(s);
 }
 
 std::size_t dofs(const edgefem_sim* sim) { return 3 * std::size_t(sim->sim.num_vertices()); }
@@ -228,12 +252,13 @@ edgefem_status edgefem_scene_create_from_arrays(const double* positions, int32_t
 }
 
 edgefem_status edgefem_scene_create_from_mesh_file(const char* path, edgefem_scene** out) {
-    return make_scene("edgefem_scene_create_from_mesh_file", out, [](const void* p) {
-        const char* path = static_cast<const char*>(p);
-        require(path, "path");
-        const std::string s(path);
-        return edgefem::is_box_spec(s) ? edgefem::make_box_from_spec(s) : edgefem::read_mesh(s);
-    }, path);
+    return make_scene("edgefem_scene_create_from_mesh_file", out, mesh_from_path, path);
+}
+
+edgefem_status edgefem_scene_create_from_mesh_file_with(const char* path, int32_t fix_orientation, int32_t compact,
+                                                       edgefem_scene** out) {
+    return make_scene("edgefem_scene_create_from_mesh_file_with", out, mesh_from_path, path,
+                      MeshFlags{fix_orientation, compact, true});
 }
 
 edgefem_status edgefem_scene_create_box(int32_t nx, int32_t ny, int32_t nz, double cell, edgefem_scene** out) {
@@ -503,6 +528,185 @@ edgefem_status edgefem_scene_set_preconditioner(edgefem_scene* scene, const char
         require(scene, "scene");
         require(name, "name");
         scene->scene.solver.preconditioner = edgefem::parse_preconditioner(name);
+    });
+}
+
+edgefem_status edgefem_scene_set_method(edgefem_scene* scene, int32_t method) {
+    return guard("edgefem_scene_set_method", [&] {
+        require(scene, "scene");
+        if (method != EDGEFEM_METHOD_EDGE && method != EDGEFEM_METHOD_TET)
+            invalid("method: " + std::to_string(method) +
+                    " is not an edgefem_method (EDGEFEM_METHOD_EDGE 0, EDGEFEM_METHOD_TET 1)");
+        scene->scene.method = method == EDGEFEM_METHOD_EDGE ? edgefem::Method::Edge : edgefem::Method::Tet;
+    });
+}
+
+edgefem_status edgefem_scene_set_linear_solver(edgefem_scene* scene, int32_t solver) {
+    return guard("edgefem_scene_set_linear_solver", [&] {
+        require(scene, "scene");
+        if (solver != EDGEFEM_LINEAR_CG && solver != EDGEFEM_LINEAR_DIRECT)
+            invalid("solver: " + std::to_string(solver) +
+                    " is not an edgefem_linear_solver (EDGEFEM_LINEAR_CG 0, EDGEFEM_LINEAR_DIRECT 1)");
+        scene->scene.solver.linear_solver =
+            solver == EDGEFEM_LINEAR_CG ? edgefem::LinearSolver::CG : edgefem::LinearSolver::Direct;
+    });
+}
+
+edgefem_status edgefem_scene_set_newton(edgefem_scene* scene, double tolerance, int32_t max_iterations,
+                                        int32_t load_steps) {
+    return guard("edgefem_scene_set_newton", [&] {
+        require(scene, "scene");
+        if (!(std::isfinite(tolerance) && tolerance > 0))
+            invalid("tolerance must be finite and positive, got " + std::to_string(tolerance));
+        if (max_iterations < 1) invalid("max_iterations must be >= 1, got " + std::to_string(max_iterations));
+        if (load_steps < 1) invalid("load_steps must be >= 1, got " + std::to_string(load_steps));
+        scene->scene.solver.newton_tolerance = tolerance;
+        scene->scene.solver.newton_max_iterations = max_iterations;
+        scene->scene.solver.load_steps = load_steps;
+    });
+}
+
+// ---- Regions ----
+
+edgefem_status edgefem_scene_get_regions(const edgefem_scene* scene, int32_t* out, size_t count) {
+    return guard("edgefem_scene_get_regions", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        const edgefem::Mesh& m = scene->scene.mesh;
+        if (count != std::size_t(m.num_tets()))
+            invalid("out: count is " + std::to_string(count) + ", expected #T = " + std::to_string(m.num_tets()));
+        for (edgefem::index_t t = 0; t < m.num_tets(); ++t) out[t] = m.tet_region(t);
+    });
+}
+
+edgefem_status edgefem_scene_set_regions(edgefem_scene* scene, const int32_t* regions, size_t count) {
+    return guard("edgefem_scene_set_regions", [&] {
+        require(scene, "scene");
+        edgefem::Mesh& m = scene->scene.mesh;
+        if (count > 0) {
+            require(regions, "regions");
+            if (count != std::size_t(m.num_tets()))
+                invalid("regions: count is " + std::to_string(count) + ", expected #T = " + std::to_string(m.num_tets()) +
+                        " (or 0: every tet in region 0)");
+        }
+        m.region.assign(regions, regions ? regions + count : regions);
+    });
+}
+
+edgefem_status edgefem_scene_set_region_material(edgefem_scene* scene, int32_t region, double young, double poisson,
+                                                 double density) {
+    return guard("edgefem_scene_set_region_material", [&] {
+        require(scene, "scene");
+        const edgefem::Material m{young, poisson, density};
+        m.validate();
+        scene->scene.materials.by_region[region] = m;
+    });
+}
+
+// ---- Tagged surfaces and surface loads ----
+
+namespace {
+std::vector<edgefem::Triangle> tagged(const edgefem_scene* scene, int32_t tag) {
+    return edgefem::tagged_triangles(scene->scene.mesh, {tag});
+}
+
+void add_load(edgefem_scene* scene, std::vector<edgefem::Triangle> triangles, double pressure, double tx, double ty,
+              double tz, const double* times, const double* values, size_t key_count) {
+    if (!std::isfinite(pressure)) invalid("pressure is not finite");
+    const double t[3] = {tx, ty, tz};
+    require_finite(t, 3, "traction", false);
+    edgefem::SurfaceLoad load;
+    load.triangles = std::move(triangles);
+    load.pressure = pressure;
+    load.traction = {tx, ty, tz};
+    load.keyframes = keyframes(times, values, key_count, "keyframes");
+    scene->scene.surface_loads.push_back(std::move(load));
+}
+}  // namespace
+
+edgefem_status edgefem_scene_surface_count(const edgefem_scene* scene, int32_t tag, size_t* num_triangles) {
+    return guard("edgefem_scene_surface_count", [&] {
+        require(scene, "scene");
+        require(num_triangles, "num_triangles");
+        *num_triangles = tagged(scene, tag).size();
+    });
+}
+
+edgefem_status edgefem_scene_get_surface(const edgefem_scene* scene, int32_t tag, int32_t* out, size_t count) {
+    return guard("edgefem_scene_get_surface", [&] {
+        require(scene, "scene");
+        require(out, "out");
+        const std::vector<edgefem::Triangle> tri = tagged(scene, tag);
+        if (count != 3 * tri.size())
+            invalid("out: count is " + std::to_string(count) + ", expected 3 x (triangles tagged " + std::to_string(tag) +
+                    ") = " + std::to_string(3 * tri.size()));
+        for (std::size_t k = 0; k < tri.size(); ++k)
+            for (int i = 0; i < 3; ++i) out[3 * k + i] = tri[k][i];
+    });
+}
+
+edgefem_status edgefem_scene_surface_tag(const edgefem_scene* scene, const char* name, int32_t* tag) {
+    return guard("edgefem_scene_surface_tag", [&] {
+        require(scene, "scene");
+        require(name, "name");
+        require(tag, "tag");
+        const std::vector<int> tags = edgefem::tags_named(scene->scene.mesh, name);
+        if (tags.size() > 1)
+            invalid("name: \"" + edgefem::printable(name) + "\" names " + std::to_string(tags.size()) +
+                    " physical surfaces (tags " + std::to_string(tags[0]) + ", " + std::to_string(tags[1]) + ", ...)");
+        *tag = tags[0];
+    });
+}
+
+edgefem_status edgefem_scene_fix_surface(edgefem_scene* scene, int32_t tag) {
+    return guard("edgefem_scene_fix_surface", [&] {
+        require(scene, "scene");
+        std::vector<edgefem::index_t>& fixed = scene->scene.fixed;
+        const std::vector<edgefem::index_t> add = edgefem::triangle_vertices(tagged(scene, tag));
+        fixed.insert(fixed.end(), add.begin(), add.end());
+        std::sort(fixed.begin(), fixed.end());
+        fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+    });
+}
+
+edgefem_status edgefem_scene_add_surface_load(edgefem_scene* scene, int32_t tag, double pressure, double tx, double ty,
+                                              double tz, const double* times, const double* values, size_t key_count) {
+    return guard("edgefem_scene_add_surface_load", [&] {
+        require(scene, "scene");
+        std::vector<edgefem::Triangle> tri;
+        try {
+            tri = edgefem::orient_outward(scene->scene.mesh, tagged(scene, tag));
+        } catch (const edgefem::MeshError& e) {
+            invalid("tag " + std::to_string(tag) + ": " + e.what());
+        }
+        add_load(scene, std::move(tri), pressure, tx, ty, tz, times, values, key_count);
+    });
+}
+
+edgefem_status edgefem_scene_add_surface_load_triangles(edgefem_scene* scene, const int32_t* triangles, size_t count,
+                                                        double pressure, double tx, double ty, double tz,
+                                                        const double* times, const double* values, size_t key_count) {
+    return guard("edgefem_scene_add_surface_load_triangles", [&] {
+        require(scene, "scene");
+        require(triangles, "triangles");
+        if (count == 0 || count % 3 != 0)
+            invalid("triangles: count is " + std::to_string(count) + ", expected a positive multiple of 3");
+        const int32_t nv = scene->scene.mesh.num_vertices();
+        std::vector<edgefem::Triangle> tri(count / 3);
+        for (size_t i = 0; i < count; ++i) {
+            if (triangles[i] < 0 || triangles[i] >= nv)
+                invalid("triangles[" + std::to_string(i) + "] = " + std::to_string(triangles[i]) +
+                        " is out of range [0, " + std::to_string(nv) + ")");
+            tri[i / 3][i % 3] = triangles[i];
+        }
+        add_load(scene, std::move(tri), pressure, tx, ty, tz, times, values, key_count);
+    });
+}
+
+edgefem_status edgefem_scene_clear_surface_loads(edgefem_scene* scene) {
+    return guard("edgefem_scene_clear_surface_loads", [&] {
+        require(scene, "scene");
+        scene->scene.surface_loads.clear();
     });
 }
 

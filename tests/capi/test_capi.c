@@ -89,6 +89,119 @@ static void make_box(int nx, int ny, int nz, double h, double** X, int32_t* nv, 
                 }
 }
 
+/* Tagged surfaces, regions, mesh options, solver settings and surface
+ * loads: the Gmsh test mesh's physical surface "skin" (tag 7), and a bar
+ * (nu = 0) pulled by a traction on its x = max face, whose static stretch is
+ * the analytic t / E at a small load. */
+static void test_surfaces_regions_loads(void) {
+    edgefem_scene* g = NULL;
+    CHECK_OK(edgefem_scene_create_from_mesh_file_with(EDGEFEM_TEST_DATA "/small22.msh", 0, 0, &g));
+    if (!g) return;
+    size_t n = 0;
+    CHECK_OK(edgefem_scene_surface_count(g, 7, &n));
+    CHECK(n == 2);
+    int32_t tri[6] = {0};
+    CHECK_OK(edgefem_scene_get_surface(g, 7, tri, 6));
+    const int32_t want[6] = {0, 1, 2, 1, 2, 4};
+    CHECK(memcmp(tri, want, sizeof want) == 0);
+    expect_error(edgefem_scene_get_surface(g, 7, tri, 5), EDGEFEM_ERROR_INVALID_ARGUMENT, "expected 3 x", "short surface buffer");
+    int32_t tag = 0;
+    CHECK_OK(edgefem_scene_surface_tag(g, "skin", &tag));
+    CHECK(tag == 7);
+    expect_error(edgefem_scene_surface_tag(g, "clamp", &tag), EDGEFEM_ERROR_INVALID_ARGUMENT, "\"clamp\"", "unknown physical name");
+    expect_error(edgefem_scene_surface_count(g, 3, &n), EDGEFEM_ERROR_INVALID_ARGUMENT, "surface tag 3", "unknown tag");
+    expect_error(edgefem_scene_add_surface_load(g, 7, 1e3, 0, 0, 0, NULL, NULL, 0), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                 "not on the boundary", "load on an interior triangle");
+    CHECK_OK(edgefem_scene_fix_surface(g, 7));
+    int32_t regions[3] = {0};
+    CHECK_OK(edgefem_scene_get_regions(g, regions, 3));
+    CHECK(regions[0] == 1 && regions[1] == 2 && regions[2] == 1);
+    expect_error(edgefem_scene_get_regions(g, regions, 2), EDGEFEM_ERROR_INVALID_ARGUMENT, "#T = 3", "short region buffer");
+    const int32_t other[3] = {4, 4, 5};
+    CHECK_OK(edgefem_scene_set_regions(g, other, 3));
+    CHECK_OK(edgefem_scene_get_regions(g, regions, 3));
+    CHECK(regions[0] == 4 && regions[2] == 5);
+    expect_error(edgefem_scene_set_regions(g, other, 2), EDGEFEM_ERROR_INVALID_ARGUMENT, "regions", "short regions");
+    CHECK_OK(edgefem_scene_set_region_material(g, 5, 2e5, 0.25, 900));
+    expect_error(edgefem_scene_set_region_material(g, 5, 2e5, 0.5, 900), EDGEFEM_ERROR_INVALID_ARGUMENT, "oisson",
+                 "region material with nu = 0.5");
+    edgefem_sim* gs = NULL;
+    CHECK_OK(edgefem_sim_create(g, &gs));
+    CHECK_OK(edgefem_sim_step(gs, NULL));
+    edgefem_sim_destroy(gs);
+    edgefem_scene_destroy(g);
+    edgefem_scene* bad = NULL;
+    expect_error(edgefem_scene_create_from_mesh_file_with(EDGEFEM_TEST_DATA "/small22.msh", 0, 2, &bad),
+                 EDGEFEM_ERROR_INVALID_ARGUMENT, "compact: 2", "compact = 2");
+    expect_error(edgefem_scene_create_from_mesh_file_with(EDGEFEM_TEST_DATA "/small22.msh", -1, 0, &bad),
+                 EDGEFEM_ERROR_INVALID_ARGUMENT, "fix_orientation: -1", "fix_orientation = -1");
+    CHECK(bad == NULL);
+
+    /* The bar: 0.1 x 0.02 x 0.02 m, clamped at x = min, t = 100 Pa on x = max. */
+    edgefem_scene* bar = NULL;
+    CHECK_OK(edgefem_scene_create_box(10, 2, 2, 0.01, &bar));
+    if (!bar) return;
+    CHECK_OK(edgefem_scene_set_material(bar, 1e6, 0.0, 1000));
+    double rest[3 * 99];
+    CHECK_OK(edgefem_scene_get_rest_positions(bar, rest, 3 * 99));
+    int32_t clamp[9], nclamp = 0;
+    for (int32_t v = 0; v < 99; ++v)
+        if (rest[3 * v] < -0.0499) clamp[nclamp++] = v;
+    CHECK(nclamp == 9);
+    CHECK_OK(edgefem_scene_set_fixed(bar, clamp, (size_t)nclamp));
+    size_t nb = 0;
+    CHECK_OK(edgefem_scene_boundary_count(bar, &nb));
+    int32_t* all = malloc(sizeof(int32_t) * 3 * nb);
+    int32_t* end = malloc(sizeof(int32_t) * 3 * nb);
+    CHECK_OK(edgefem_scene_get_boundary(bar, all, 3 * nb));
+    size_t nend = 0;
+    for (size_t k = 0; k < nb; ++k) {
+        int on = 1;
+        for (int i = 0; i < 3; ++i) on = on && rest[3 * all[3 * k + i]] > 0.0499;
+        if (on)
+            for (int i = 0; i < 3; ++i) end[nend++] = all[3 * k + i];
+    }
+    CHECK(nend == 3 * 8);
+    const double times[2] = {0, 1}, values[2] = {1, 1};
+    CHECK_OK(edgefem_scene_add_surface_load_triangles(bar, end, nend, 0, 100, 0, 0, times, values, 2));
+    expect_error(edgefem_scene_add_surface_load_triangles(bar, end, 4, 0, 1, 0, 0, NULL, NULL, 0),
+                 EDGEFEM_ERROR_INVALID_ARGUMENT, "multiple of 3", "4 triangle indices");
+    end[1] = 99;
+    expect_error(edgefem_scene_add_surface_load_triangles(bar, end, 3, 0, 1, 0, 0, NULL, NULL, 0),
+                 EDGEFEM_ERROR_INVALID_ARGUMENT, "triangles[1] = 99", "triangle vertex out of range");
+    expect_error(edgefem_scene_add_surface_load_triangles(bar, all, 3, NAN, 0, 0, 0, NULL, NULL, 0),
+                 EDGEFEM_ERROR_INVALID_ARGUMENT, "pressure", "NaN pressure");
+    expect_error(edgefem_scene_set_linear_solver(bar, 2), EDGEFEM_ERROR_INVALID_ARGUMENT, "solver: 2", "linear solver 2");
+    expect_error(edgefem_scene_set_method(bar, -1), EDGEFEM_ERROR_INVALID_ARGUMENT, "method: -1", "method -1");
+    expect_error(edgefem_scene_set_newton(bar, 0, 10, 1), EDGEFEM_ERROR_INVALID_ARGUMENT, "tolerance", "Newton tolerance 0");
+    CHECK_OK(edgefem_scene_set_method(bar, EDGEFEM_METHOD_EDGE));
+    CHECK_OK(edgefem_scene_set_linear_solver(bar, EDGEFEM_LINEAR_DIRECT));
+    CHECK_OK(edgefem_scene_set_newton(bar, 1e-12, 50, 1));
+    edgefem_sim* bs = NULL;
+    CHECK_OK(edgefem_sim_create(bar, &bs));
+    if (bs) {
+        int32_t converged = 0;
+        CHECK_OK(edgefem_sim_solve_static(bs, &converged));
+        CHECK(converged == 1);
+        double u[3 * 99];
+        CHECK_OK(edgefem_sim_get_displacement(bs, u, 3 * 99));
+        const double strain = 100 / 1e6;
+        double worst = 0;
+        for (int32_t v = 0; v < 99; ++v) {
+            const double want_ux = strain * (rest[3 * v] + 0.05);
+            const double d = fabs(u[3 * v] - want_ux) + fabs(u[3 * v + 1]) + fabs(u[3 * v + 2]);
+            if (d > worst) worst = d;
+        }
+        printf("  bar under 100 Pa: max |u - t/E x| = %.3g m (t/E x at the end: %.3g m)\n", worst, strain * 0.1);
+        CHECK(worst < 1e-3 * strain * 0.1);
+        edgefem_sim_destroy(bs);
+    }
+    CHECK_OK(edgefem_scene_clear_surface_loads(bar));
+    free(all);
+    free(end);
+    edgefem_scene_destroy(bar);
+}
+
 int main(void) {
     printf("edgefem %s, C API %d\n", edgefem_version_string(), EDGEFEM_C_API_VERSION);
     double* X;
@@ -376,6 +489,8 @@ int main(void) {
     }
     edgefem_sim_destroy(unstable);
     edgefem_scene_destroy(stiff);
+
+    test_surfaces_regions_loads();
 
     /* The simulation still works after all that. */
     CHECK_OK(edgefem_sim_step(sim, NULL));

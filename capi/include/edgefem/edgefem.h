@@ -96,6 +96,18 @@ typedef enum edgefem_model {
     EDGEFEM_MODEL_SN = 1  /**< the nonlinear spring network (its special case) */
 } edgefem_model;
 
+/** Elastic methods (the same StVK element; docs/formulation.md). */
+typedef enum edgefem_method {
+    EDGEFEM_METHOD_EDGE = 0, /**< the edge-based kernels */
+    EDGEFEM_METHOD_TET = 1   /**< the conventional per-tet kernels */
+} edgefem_method;
+
+/** Linear solvers of the implicit steps (docs/solvers.md). */
+typedef enum edgefem_linear_solver {
+    EDGEFEM_LINEAR_CG = 0,    /**< matrix-free CG with the scene's preconditioner */
+    EDGEFEM_LINEAR_DIRECT = 1 /**< the assembled K factorised by CHOLMOD */
+} edgefem_linear_solver;
+
 /** What a step cost and did (a subset of the C++ StepStats). */
 typedef struct edgefem_step_stats {
     double force_ms;          /**< internal forces */
@@ -141,6 +153,13 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_arrays(const double* p
 /** A scene on a mesh file (TetGen .node/.ele or prefix, Gmsh .msh, MEDIT
  *  .mesh, Vega .veg) or a "box:NXxNYxNZ" spec, with the defaults above. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_mesh_file(const char* path, edgefem_scene** out);
+/** The same with the mesh options of a scene file's "mesh_options" (0 or 1
+ *  each; anything else is EDGEFEM_ERROR_INVALID_ARGUMENT naming it):
+ *  `fix_orientation` reorients inverted tets instead of refusing the mesh,
+ *  `compact` removes vertices no tet uses (renumbering the rest, and the
+ *  tagged triangles with them; the file's other vertex order is kept). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_mesh_file_with(const char* path, int32_t fix_orientation,
+                                                                         int32_t compact, edgefem_scene** out);
 /** A scene from a JSON scene file (docs/scenes.md): everything it sets. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_create_from_json(const char* path, edgefem_scene** out);
 /** A scene on a generated box of nx x ny x nz cubes of side `cell`, centred at
@@ -166,9 +185,65 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_tets(const edgefem_scene* scen
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_boundary_count(const edgefem_scene* scene, size_t* num_triangles);
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_boundary(const edgefem_scene* scene, int32_t* out, size_t count);
 /** One material for the whole mesh: Young's modulus (Pa), Poisson ratio in
- *  (-1, 0.5), density (kg/m^3). */
+ *  (-1, 0.5), density (kg/m^3). Replaces every region's material too. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_material(edgefem_scene* scene, double young, double poisson,
                                                            double density);
+
+/* ---- Regions: per-tet ids and per-region materials -------------------- */
+
+/** Copies each tet's region id (count = num_tets): the mesh file's tet
+ *  attribute (TetGen), physical tag (Gmsh), reference (MEDIT) or material
+ *  index (Vega); 0 where the mesh has none. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_regions(const edgefem_scene* scene, int32_t* out, size_t count);
+/** Replaces the tets' region ids (count = num_tets; count 0: every tet in region 0). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_regions(edgefem_scene* scene, const int32_t* regions,
+                                                          size_t count);
+/** The material of the tets of region `region` (the others keep theirs, or
+ *  the scene's material). The values are checked as edgefem_scene_set_material's. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_region_material(edgefem_scene* scene, int32_t region, double young,
+                                                                  double poisson, double density);
+
+/* ---- Tagged surfaces (docs/scenes.md, "Surface selections") ------------ */
+
+/** The mesh file's tagged boundary triangles with tag `tag` (Gmsh physical
+ *  surface, or its surface entity when it has none; TetGen .face boundary
+ *  marker; MEDIT Triangles reference): their count, then the triangles (3
+ *  vertex indices each, count = 3 x num_triangles, in the file's winding). A
+ *  tag no triangle has is EDGEFEM_ERROR_INVALID_ARGUMENT naming it and the
+ *  tags there are. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_surface_count(const edgefem_scene* scene, int32_t tag,
+                                                            size_t* num_triangles);
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_get_surface(const edgefem_scene* scene, int32_t tag, int32_t* out,
+                                                          size_t count);
+/** The tag of a Gmsh physical surface's name ($PhysicalNames); a name no
+ *  surface has, or one that names several tags, is
+ *  EDGEFEM_ERROR_INVALID_ARGUMENT naming it. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_surface_tag(const edgefem_scene* scene, const char* name, int32_t* tag);
+/** Adds the vertices of the triangles tagged `tag` to the fixed vertices. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_fix_surface(edgefem_scene* scene, int32_t tag);
+
+/* ---- Surface loads (docs/scenes.md, "Surface loads") -------------------- */
+
+/** Adds a pressure (Pa; positive pushes into the body, along the inward
+ *  normal) and a traction (tx, ty, tz: Pa, force per area, a fixed vector)
+ *  on the boundary triangles tagged `tag`, scaled by keyframes (times,
+ *  values, key_count; 0 keys: constant). Dead loads on the rest surface:
+ *  each triangle's force (t - p n) A goes to its vertices in thirds. A tag
+ *  no triangle has, or a tagged triangle that is not on the boundary, is
+ *  EDGEFEM_ERROR_INVALID_ARGUMENT naming it. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_add_surface_load(edgefem_scene* scene, int32_t tag, double pressure,
+                                                               double tx, double ty, double tz, const double* times,
+                                                               const double* values, size_t key_count);
+/** The same on triangles given as 3 vertex indices each (count = 3 x
+ *  triangles), wound so that (b - a) x (c - a) points out of the body, as
+ *  edgefem_scene_get_boundary gives them (all of them: the whole boundary). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_add_surface_load_triangles(edgefem_scene* scene,
+                                                                         const int32_t* triangles, size_t count,
+                                                                         double pressure, double tx, double ty,
+                                                                         double tz, const double* times,
+                                                                         const double* values, size_t key_count);
+/** Removes every surface load. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_clear_surface_loads(edgefem_scene* scene);
 /** Replaces the fixed vertices (held at rest); count 0 frees all. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_fixed(edgefem_scene* scene, const int32_t* vertices,
                                                         size_t count);
@@ -209,6 +284,18 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_load(edgefem_scene* scene, con
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_model(edgefem_scene* scene, int32_t model);
 /** Rayleigh damping D = alpha M + beta K. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_damping(edgefem_scene* scene, double alpha, double beta);
+/** Elastic method: an ::edgefem_method value; any other integer is
+ *  EDGEFEM_ERROR_INVALID_ARGUMENT. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_method(edgefem_scene* scene, int32_t method);
+/** Linear solver of the implicit steps and static solves: an
+ *  ::edgefem_linear_solver value; any other integer is
+ *  EDGEFEM_ERROR_INVALID_ARGUMENT. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_linear_solver(edgefem_scene* scene, int32_t solver);
+/** Newton's settings (the Newton integrators and static solves): relative
+ *  tolerance (> 0), iteration cap (>= 1) and the static solve's initial
+ *  number of load steps (>= 1). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_scene_set_newton(edgefem_scene* scene, double tolerance,
+                                                         int32_t max_iterations, int32_t load_steps);
 /** CG settings: relative tolerance, iteration cap, and a fixed budget
  *  (`fixed_iterations` > 0: exactly that many warm-started iterations per
  *  solve, the real-time setting; 0: iterate to the tolerance). */
