@@ -80,6 +80,12 @@ class Mesh:
     def tets(self) -> _IndexArray: ...
     region: list[int]
     @property
+    def surface_triangles(self) -> _IndexArray: ...
+    @property
+    def surface_tags(self) -> list[int]: ...
+    @property
+    def surface_names(self) -> dict[int, str]: ...
+    @property
     def num_vertices(self) -> int: ...
     @property
     def num_tets(self) -> int: ...
@@ -139,6 +145,22 @@ class SolverSettings:
     amg_refresh_interval: int
     def __init__(self) -> None: ...
 
+class SurfaceLoad:
+    def __init__(
+        self,
+        triangles: npt.ArrayLike,
+        pressure: float = 0.0,
+        traction: tuple[float, float, float] | Sequence[float] = (0, 0, 0),
+        keyframes: Sequence[Keyframe] = ...,
+    ) -> None: ...
+    @property
+    def triangles(self) -> _IndexArray: ...
+    @triangles.setter
+    def triangles(self, value: npt.ArrayLike) -> None: ...
+    pressure: float
+    traction: list[float]
+    keyframes: list[Keyframe]
+
 class Scene:
     def __init__(
         self,
@@ -169,6 +191,7 @@ class Scene:
     prescribed_keyframes: list[Keyframe]
     load: list[float]
     load_keyframes: list[Keyframe]
+    surface_loads: list[SurfaceLoad]
     initial_displacement: list[float]
     initial_velocity: list[float]
     dt: float
@@ -331,6 +354,8 @@ class ElasticModel:
 
 def deformation(mesh: Mesh | MeshView, kind: str = "twist", scale: float = 1.0) -> _Float64Array: ...
 def boundary_surface(mesh: Mesh | MeshView) -> tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]: ...
+def select_surface(mesh: Mesh | MeshView, tag: int | str, outward: bool = True) -> npt.NDArray[np.int32]: ...
+def surface_load_forces(mesh: Mesh | MeshView, load: SurfaceLoad) -> _Float64Array: ...
 
 class Embedding:
     @property

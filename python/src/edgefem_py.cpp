@@ -23,6 +23,7 @@
 #include <span>
 #include <string>
 #include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "lab/deformations.hpp"
@@ -34,6 +35,8 @@
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/surface.hpp"
+#include "edgefem/core/surface_load.hpp"
+#include "edgefem/core/surface_selection.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 #include "edgefem/core/write_vtu.hpp"
 #include "edgefem/parallel/run_options.hpp"
@@ -136,6 +139,24 @@ py::array_t<double> new_vectors(const std::vector<double>& v) {
     return out;
 }
 
+// Triangles (3 indices each) as a new (F, 3) int32 array.
+py::array_t<std::int32_t> triangle_array(const std::vector<index_t>& v) {
+    py::array_t<std::int32_t> a({py::ssize_t(v.size() / 3), py::ssize_t(3)});
+    std::copy(v.begin(), v.end(), a.mutable_data());
+    return a;
+}
+py::array_t<std::int32_t> triangle_array(const std::vector<std::array<index_t, 3>>& t) {
+    std::vector<index_t> v;
+    for (const auto& x : t) v.insert(v.end(), x.begin(), x.end());
+    return triangle_array(v);
+}
+std::vector<std::array<index_t, 3>> triangles_arg(py::handle obj, const std::string& name) {
+    const std::vector<index_t> t = index_rows_arg(obj, name, 3);
+    std::vector<std::array<index_t, 3>> tri(t.size() / 3);
+    for (std::size_t k = 0; k < tri.size(); ++k) tri[k] = {t[3 * k], t[3 * k + 1], t[3 * k + 2]};
+    return tri;
+}
+
 Mesh mesh_from_arrays(py::handle X, py::handle tets, std::optional<std::vector<int>> region) {
     const InArray x = vectors_arg(X, "X", -1, false);
     Mesh m;
@@ -174,6 +195,7 @@ void set_scene_mesh(Scene& s, const Mesh& m) {
         std::copy(m.X.begin(), m.X.end(), old.X.begin());
         std::copy(m.tets.begin(), m.tets.end(), old.tets.begin());
         old.region = m.region;
+        old.surfaces = m.surfaces;
         old.source = m.source;
         return;
     }
@@ -332,6 +354,12 @@ PYBIND11_MODULE(_edgefem, m) {
             "(N, 3) view; assigning copies into it (same shape).")
         .def_property_readonly("tets", [](py::object self) { return mesh_tets(self.cast<Mesh&>(), self); })
         .def_readwrite("region", &Mesh::region)
+        .def_property_readonly("surface_triangles", [](const Mesh& me) { return triangle_array(me.surfaces.vertices); },
+                               "The mesh file's tagged boundary triangles (F, 3), in the file's winding (a copy).")
+        .def_property_readonly("surface_tags", [](const Mesh& me) { return me.surfaces.tag; },
+                               "The tag of each tagged triangle (Gmsh physical, TetGen marker, MEDIT reference).")
+        .def_property_readonly("surface_names", [](const Mesh& me) { return me.surfaces.names; },
+                               "Gmsh physical surface names: {tag: name}.")
         .def_property_readonly("num_vertices", &Mesh::num_vertices)
         .def_property_readonly("num_tets", &Mesh::num_tets)
         .def(
@@ -428,6 +456,26 @@ PYBIND11_MODULE(_edgefem, m) {
         .def_readwrite("fail_on_unconverged", &SolverSettings::fail_on_unconverged)
         .def_readwrite("max_energy_growth", &SolverSettings::max_energy_growth);
 
+    py::class_<SurfaceLoad>(m, "SurfaceLoad",
+                            "A pressure (Pa, positive pushes into the body) and a traction (Pa, a fixed vector per area) "
+                            "on triangles (F, 3) wound outward, scaled by keyframes; dead loads on the rest surface.")
+        .def(py::init([](py::handle triangles, double pressure, std::array<double, 3> traction,
+                         std::vector<Keyframe> keyframes) {
+                 SurfaceLoad l;
+                 l.triangles = triangles_arg(triangles, "triangles");
+                 l.pressure = pressure;
+                 l.traction = traction;
+                 l.keyframes = std::move(keyframes);
+                 return l;
+             }),
+             py::arg("triangles"), py::arg("pressure") = 0.0, py::arg("traction") = std::array<double, 3>{0, 0, 0},
+             py::arg("keyframes") = std::vector<Keyframe>{})
+        .def_property(
+            "triangles", [](const SurfaceLoad& l) { return triangle_array(l.triangles); },
+            [](SurfaceLoad& l, py::handle t) { l.triangles = triangles_arg(t, "triangles"); }, "(F, 3) int32 (a copy).")
+        .def_readwrite("pressure", &SurfaceLoad::pressure)
+        .def_readwrite("traction", &SurfaceLoad::traction)
+        .def_readwrite("keyframes", &SurfaceLoad::keyframes);
     py::class_<Scene>(m, "Scene", "Mesh, material, loads, constraints and integrator settings (docs/scenes.md).")
         .def(py::init([](Mesh mesh, const Material& material, std::vector<index_t> fixed,
                          std::array<double, 3> gravity, double dt, Integrator integrator, ModelKind model,
@@ -478,6 +526,7 @@ PYBIND11_MODULE(_edgefem, m) {
         .def_readwrite("prescribed_keyframes", &Scene::prescribed_keyframes)
         .def_readwrite("load", &Scene::load, "External load, 3 x #V values (N; empty: none).")
         .def_readwrite("load_keyframes", &Scene::load_keyframes)
+        .def_readwrite("surface_loads", &Scene::surface_loads, "Pressure and traction loads (a list of SurfaceLoad, copied).")
         .def_readwrite("initial_displacement", &Scene::initial_displacement, "3 x #V values (empty: rest).")
         .def_readwrite("initial_velocity", &Scene::initial_velocity, "3 x #V values (empty: rest).")
         .def_readwrite("dt", &Scene::dt)
@@ -710,6 +759,25 @@ PYBIND11_MODULE(_edgefem, m) {
         },
         py::arg("mesh"),
         "The mesh's boundary: (triangles (F, 3) wound outward, the tet of each (F,)).");
+    m.def(
+        "select_surface",
+        [](const Mesh& mesh, std::variant<int, std::string> tag, bool outward) {
+            const std::vector<int> tags =
+                std::holds_alternative<int>(tag) ? std::vector<int>{std::get<int>(tag)} : tags_named(mesh, std::get<std::string>(tag));
+            const std::vector<Triangle> t = tagged_triangles(mesh, tags);
+            return triangle_array(outward ? orient_outward(mesh, t) : t);
+        },
+        py::arg("mesh"), py::arg("tag"), py::arg("outward") = true,
+        "The mesh file's triangles with a surface tag (int) or Gmsh physical name (str), (F, 3); outward: wound "
+        "outward (MeshError for a triangle not on the boundary), else in the file's winding.");
+    m.def(
+        "surface_load_forces",
+        [](const Mesh& mesh, const SurfaceLoad& load) {
+            std::vector<double> f(mesh.X.size(), 0.0);
+            add_surface_load_forces(mesh.X, load, 1.0, f);
+            return new_vectors(f);
+        },
+        py::arg("mesh"), py::arg("load"), "The load's nodal forces (#V, 3) (N) at full scale.");
     py::class_<Embedding>(m, "Embedding", "Points of a render surface placed in a mesh's tets (embed_points).")
         .def_property_readonly("tet",
                                [](const Embedding& e) {
@@ -751,9 +819,7 @@ PYBIND11_MODULE(_edgefem, m) {
         "vertex_normals",
         [](py::handle triangles, py::handle positions) {
             const InArray x = vectors_arg(positions, "positions", -1, true);
-            const std::vector<index_t> t = index_rows_arg(triangles, "triangles", 3);
-            std::vector<std::array<index_t, 3>> tri(t.size() / 3);
-            for (std::size_t k = 0; k < tri.size(); ++k) tri[k] = {t[3 * k], t[3 * k + 1], t[3 * k + 2]};
+            const std::vector<std::array<index_t, 3>> tri = triangles_arg(triangles, "triangles");
             return new_vectors(vertex_normals(tri, std::span<const double>(x.data(), std::size_t(x.size()))));
         },
         py::arg("triangles"), py::arg("positions"),
