@@ -259,26 +259,23 @@ void read_entities_41(detail::TextReader& r, GmshData& d) {
     for (auto& c : counts) c = r.check_count(c, 4, "entity");
     for (std::int64_t i = 0; i < counts[0] + counts[1]; ++i)
         r.require_line("a point or curve entity");
-    for (std::int64_t i = 0; i < counts[2]; ++i) {
-        r.require_line("surface entity " + std::to_string(i + 1));
-        auto tk = r.tokens();
-        const std::int64_t tag = r.next_int(tk, "surface tag");
-        for (int k = 0; k < 6; ++k) r.next_double(tk, "bounding box coordinate");
-        const std::int64_t nphys = r.next_int(tk, "number of physical tags");
-        if (nphys < 0 || static_cast<std::size_t>(nphys) > tk.count())
-            r.fail("bad number of physical tags " + std::to_string(nphys));
-        if (nphys > 0) d.surface_physical[tag] = r.next_int(tk, "physical tag");
-    }
-    for (std::int64_t i = 0; i < counts[3]; ++i) {
-        r.require_line("volume entity " + std::to_string(i + 1));
-        auto tk = r.tokens();
-        const std::int64_t tag = r.next_int(tk, "volume tag");
-        for (int k = 0; k < 6; ++k) r.next_double(tk, "bounding box coordinate");
-        const std::int64_t nphys = r.next_int(tk, "number of physical tags");
-        if (nphys < 0 || static_cast<std::size_t>(nphys) > tk.count())
-            r.fail("bad number of physical tags " + std::to_string(nphys));
-        if (nphys > 0) d.volume_physical[tag] = r.next_int(tk, "physical tag");
-    }
+    // Surface and volume entities: 'tag box(6) nphys phys ...'; the first
+    // physical tag, if any, is kept.
+    const auto entities = [&](std::int64_t count, const std::string& kind,
+                              std::unordered_map<std::int64_t, std::int64_t>& physical) {
+        for (std::int64_t i = 0; i < count; ++i) {
+            r.require_line(kind + " entity " + std::to_string(i + 1));
+            auto tk = r.tokens();
+            const std::int64_t tag = r.next_int(tk, kind + " tag");
+            for (int k = 0; k < 6; ++k) r.next_double(tk, "bounding box coordinate");
+            const std::int64_t nphys = r.next_int(tk, "number of physical tags");
+            if (nphys < 0 || static_cast<std::size_t>(nphys) > tk.count())
+                r.fail("bad number of physical tags " + std::to_string(nphys));
+            if (nphys > 0) physical[tag] = r.next_int(tk, "physical tag");
+        }
+    };
+    entities(counts[2], "surface", d.surface_physical);
+    entities(counts[3], "volume", d.volume_physical);
     expect_line(r, "$EndEntities", "after the entities");
 }
 

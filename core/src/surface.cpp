@@ -6,6 +6,7 @@
 #include <string>
 
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/surface_selection.hpp"
 #include "edgefem/core/validate_mesh.hpp"
 
 namespace edgefem {
@@ -107,14 +108,7 @@ struct TetGrid {
 
 }  // namespace
 
-std::vector<index_t> BoundarySurface::vertices() const {
-    std::vector<index_t> v;
-    v.reserve(3 * triangles.size());
-    for (const auto& t : triangles) v.insert(v.end(), t.begin(), t.end());
-    std::sort(v.begin(), v.end());
-    v.erase(std::unique(v.begin(), v.end()), v.end());
-    return v;
-}
+std::vector<index_t> BoundarySurface::vertices() const { return triangle_vertices(triangles); }
 
 BoundarySurface boundary_surface(const Mesh& mesh) {
     check_mesh_indices(mesh);
