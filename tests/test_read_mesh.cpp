@@ -337,7 +337,7 @@ TEST(read_mesh_errors, EditedVariants) {
     // A skipped section's count too large or too small: the message names it.
     p = write("skipbig.mesh", replace_once(medit, "triangles\n2\n", "triangles\n5\n"));
     expect_mesh_error([&] { read_medit(p); },
-                      {"skipbig.mesh:25:", "while skipping section triangles (5 items)", "found keyword 'TETRAHEDRA'"});
+                      {"skipbig.mesh:25:", "while reading section triangles (5 items)", "found keyword 'TETRAHEDRA'"});
     p = write("skipsmall.mesh", replace_once(medit, "triangles\n2\n", "triangles\n1\n"));
     expect_mesh_error([&] { read_medit(p); },
                       {"skipsmall.mesh:24:", "expected a section keyword, got '2'", "section triangles"});

@@ -101,15 +101,31 @@ void read_tets(detail::TextReader& r, Words& words, int nodes, Mesh& mesh, TetSe
     }
 }
 
+// Moves to item line i of a section of `count` (`verb`: "skipping" or
+// "reading"). An item line starts with a number, so a keyword where an item
+// should be means the count is too large.
+void require_item(detail::TextReader& r, const char* verb, const std::string& name, index_t count, index_t i) {
+    r.require_line("item " + std::to_string(i + 1) + " of section " + name);
+    const char c = r.line().front();
+    if (!(c == '-' || c == '+' || c == '.' || (c >= '0' && c <= '9')))
+        r.fail(std::string("while ") + verb + " section " + name + " (" + std::to_string(count) + " items): expected item " +
+               std::to_string(i + 1) + ", found keyword '" + detail::quote(r.tokens().next()) + "'");
+}
+
+void skip_items(detail::TextReader& r, const std::string& name, index_t count) {
+    for (index_t i = 0; i < count; ++i) require_item(r, "skipping", name, count, i);
+}
+
 // A Triangles section: item lines 'a b c [reference]' (1-based), kept as
 // the mesh's tagged triangles (resolved at the end, as the tets).
-void read_triangles(detail::TextReader& r, Words& words, std::vector<std::int64_t>& raw, Mesh& mesh) {
+void read_triangles(detail::TextReader& r, Words& words, const std::string& name, std::vector<std::int64_t>& raw,
+                    Mesh& mesh) {
     const index_t n = r.check_count(words.next_int("the triangle count"), 3, "triangle");
     words.end_of_header("the triangle count");
     if (std::int64_t(mesh.surfaces.size()) + n > std::numeric_limits<index_t>::max())
         r.fail("the Triangles sections hold more than 2^31-1 triangles");
     for (index_t i = 0; i < n; ++i) {
-        r.require_line("triangle " + std::to_string(i + 1) + " of " + std::to_string(n));
+        require_item(r, "reading", name, n, i);
         auto tk = r.tokens();
         for (int k = 0; k < 3; ++k) raw.push_back(r.next_int(tk, "vertex index"));
         std::int64_t ref = 0;
@@ -122,18 +138,6 @@ void read_triangles(detail::TextReader& r, Words& words, std::vector<std::int64_
     }
 }
 
-// Skips a section of `count` item lines. An item line starts with a number,
-// so a keyword where an item should be means the count is too large.
-void skip_items(detail::TextReader& r, const std::string& name, index_t count) {
-    const std::string context = "while skipping section " + name + " (" + std::to_string(count) + " items): ";
-    for (index_t i = 0; i < count; ++i) {
-        r.require_line("item " + std::to_string(i + 1) + " of section " + name);
-        const char c = r.line().front();
-        if (!(c == '-' || c == '+' || c == '.' || (c >= '0' && c <= '9')))
-            r.fail(context + "expected item " + std::to_string(i + 1) + ", found keyword '" +
-                   detail::quote(r.tokens().next()) + "'");
-    }
-}
 
 // A section keyword starts with a letter; a number there means the previous
 // section has more items than its count.
@@ -219,7 +223,7 @@ Mesh read_medit(const std::string& path, ReadReport* report) {
         } else if (kw == "triangles") {
             // Kept as tagged triangles; still counted with the elements not simulated.
             const std::size_t before = mesh.surfaces.size();
-            read_triangles(r, words, triangles, mesh);
+            read_triangles(r, words, previous, triangles, mesh);
             const auto n = static_cast<std::int64_t>(mesh.surfaces.size() - before);
             skipped[previous] += n;
             if (report) report->skipped_elements += n;

@@ -515,7 +515,7 @@ void read_prescribed(const Context& cx, const json& v, const Renumbering& renumb
     const json* f = find(v, "file");
     const json* sel = find(v, "select");
     const json* d = find(v, "displacement");
-    if (!f && !sel) cx.fail(p, "expected \"file\" (targets per vertex) or \"select\" with \"displacement\"");
+    if (!f && !sel) cx.fail(join(p, "file"), "required key missing (or \"select\" with \"displacement\")");
     if (sel && !d) cx.fail(join(p, "displacement"), "required key missing (with \"select\")");
     if (d && !sel) cx.fail(join(p, "displacement"), "applies only to the vertices of \"select\"");
     if (f) {
