@@ -14,8 +14,10 @@
 //          matrix; memory of each preconditioner against the per-edge K's.
 // Medians over rounds; serial (one thread). Usage:
 //   edgefem_bench_solvers [--meshes beam,bunny-4k] [--dts 1,4,10] [--rounds 9] [--parts direct,step,matrix]
-//                         [--amg-smoothing N] [--amg-coarse DOFS] [--quick]
-// (--amg-*: the matrix part's AmgSettings, to study the hierarchy)
+//                         [--amg-smoother chebyshev|l1] [--amg-smoothing N] [--amg-coarse DOFS]
+//                         [--amg-levels N] [--amg-ratio R] [--amg-weight W] [--amg-strength S] [--no-hypre] [--quick]
+// (--amg-*: AmgSettings' fields, for the step and matrix parts, to study the
+// hierarchy; unset ones keep SolverSettings' defaults)
 #include <HYPRE.h>
 #include <HYPRE_parcsr_ls.h>
 #include <mpi.h>
@@ -68,6 +70,19 @@ double median(std::vector<double> v) {
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
+bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
+
+std::string describe(const AmgSettings& a) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "AMG: %s smoother, %d step(s), coarsest <= %d dofs, <= %d levels, Chebyshev ratio %g, prolongator "
+                  "weight %g, strength %g",
+                  a.smoother == AmgSmoother::Chebyshev ? "Chebyshev" : "l1 block-Jacobi", a.smoothing_steps,
+                  a.max_coarse_dofs, a.max_levels, a.chebyshev_ratio, a.prolongator_weight, a.strength);
+    return buf;
+}
+
 Scene named_scene(const std::string& name) {
     if (name == "beam") return default_scene();
     Scene s = step_benchmark_scene(bench::bench_mesh(name), Material{1e5, 0.3, 1000});
@@ -80,6 +95,7 @@ void for_solve(Scene& s, double dt_ms, PreconditionerKind pc) {
     s.solver.cg_tolerance = 1e-6;
     s.solver.cg_max_iterations = 20000;
     s.solver.preconditioner = pc;
+    s.solver.amg = g_amg;
     s.count_inverted_tets = false;
 }
 
@@ -149,7 +165,6 @@ std::string blas_library() {
     return path;
 }
 
-AmgSettings g_amg;  // the matrix part's AMG settings (--amg-smoothing, --amg-coarse)
 
 void bench_direct(int rounds) {
     Scene s = default_scene();
@@ -439,6 +454,7 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
                 t0 = Clock::now();
                 its_sa.push_back(pcg(A, b, x_sa, 1e-6, sa_apply));
                 t_sa.push_back(ms_since(t0));
+                if (g_no_hypre) continue;
                 const HypreResult h = hypre_solve(Af, bf, x_h);
                 its_h.push_back(h.iterations);
                 setup_h.push_back(h.setup_ms);
@@ -446,7 +462,7 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
             }
             double x_max = 0;
             for (std::size_t i = 0; i < n; ++i) x_max = std::max(x_max, std::abs(x_sa[Eigen::Index(i)]));
-            for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t i = 0; i < n && !g_no_hypre; ++i)
                 if (dof[i] >= 0) x_diff = std::max(x_diff, std::abs(x_h[dof[i]] - x_sa[Eigen::Index(i)]) / x_max);
             const double sa_bytes = double(sa.bytes()) + double(A.nonZeros()) * 20.0;  // + the assembled fine A (values, indices, blocks)
             const double refresh = refresh_sa.empty() ? NAN : median(refresh_sa);
@@ -455,9 +471,11 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
             std::printf("| %s | %g | edgefem SA-AMG (%d levels; build %.1f, refresh) | %.0f | %.2f | %.2f | %.2f | %.2f |\n",
                         m.c_str(), dt, sa.levels(), setup_sa[0], median(its_sa), refresh, median(t_sa),
                         refresh + median(t_sa), sa_bytes / k_bytes);
-            std::printf("| %s | %g | hypre BoomerAMG (systems, nodal) | %.0f | %.2f | %.2f | %.2f | - |\n", m.c_str(), dt,
-                        median(its_h), median(setup_h), median(t_h), median(setup_h) + median(t_h));
-            std::printf("|  |  | (hypre and SA solutions differ by %.1e of max) |  |  |  |  |  |\n", x_diff);
+            if (!g_no_hypre) {
+                std::printf("| %s | %g | hypre BoomerAMG (systems, nodal) | %.0f | %.2f | %.2f | %.2f | - |\n", m.c_str(),
+                            dt, median(its_h), median(setup_h), median(t_h), median(setup_h) + median(t_h));
+                std::printf("|  |  | (hypre and SA solutions differ by %.1e of max) |  |  |  |  |  |\n", x_diff);
+            }
             std::fflush(stdout);
         }
 }
@@ -494,6 +512,19 @@ int main(int argc, char** argv) {
         else if (a == "--parts") parts = next();
         else if (a == "--amg-smoothing") g_amg.smoothing_steps = std::max(1, std::stoi(next()));
         else if (a == "--amg-coarse") g_amg.max_coarse_dofs = std::max(1, std::stoi(next()));
+        else if (a == "--no-hypre") g_no_hypre = true;
+        else if (a == "--amg-levels") g_amg.max_levels = std::max(1, std::stoi(next()));
+        else if (a == "--amg-ratio") g_amg.chebyshev_ratio = std::stod(next());
+        else if (a == "--amg-weight") g_amg.prolongator_weight = std::stod(next());
+        else if (a == "--amg-strength") g_amg.strength = std::stod(next());
+        else if (a == "--amg-smoother") {
+            const std::string k = next();
+            if (k != "chebyshev" && k != "l1") {
+                std::fprintf(stderr, "edgefem_bench_solvers: --amg-smoother must be chebyshev or l1, not %s\n", k.c_str());
+                return 2;
+            }
+            g_amg.smoother = k == "chebyshev" ? AmgSmoother::Chebyshev : AmgSmoother::L1Jacobi;
+        }
         else if (a == "--quick") {
             meshes = {"box-1200"};
             dts = {4};
@@ -504,6 +535,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
+    std::printf("%s\n", describe(g_amg).c_str());
     if (parts.find("direct") != std::string::npos) bench_direct(rounds);
     if (parts.find("step") != std::string::npos) bench_steps(meshes, dts, rounds);
     if (parts.find("matrix") != std::string::npos) {

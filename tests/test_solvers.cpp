@@ -1,14 +1,20 @@
 // The linear solvers: CHOLMOD's factorisation (SparseCholesky) against
 // dense LU, its symbolic analysis reused; smoothed aggregation's hierarchy
 // (the rigid-body modes reproduced by the tentative prolongators and nearly
-// in K's nullspace); AMG-preconditioned CG, block-Jacobi CG and the direct
+// in K's nullspace; the V-cycle symmetric and positive with each smoother;
+// the Chebyshev smoother's damping of the top of the spectrum by its
+// polynomial's bound); AMG-preconditioned CG, block-Jacobi CG and the direct
 // solver reaching the same step to 1e-8; AMG's iterations at a large step;
 // the preconditioner's name checked.
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+
 #include <cmath>
+#include <string>
 
 #include "cantilever.hpp"
+#include "edgefem/core/make_box.hpp"
 #include "edgefem/core/read_mesh.hpp"
 #include "edgefem/core/reference_operator.hpp"
 #include "edgefem/core/scene_json.hpp"
@@ -180,6 +186,132 @@ TEST(SmoothedAggregation, TentativeProlongatorsReproduceTheRigidBodyModes) {
         amg.apply(r2.data(), z2.data(), fine);
         EXPECT_NEAR(dot(r2, z1), dot(r1, z2), 1e-10 * std::abs(dot(r1, z2)));
         EXPECT_GT(dot(r1, z1), 0);
+    }
+}
+
+namespace {
+
+// A = K + 50 I at rest on an nx x ny x nz box with its first `fixed`
+// vertices fixed, projected as the simulator's (rows and columns of fixed
+// dofs zero).
+struct BoxSystem {
+    Mesh mesh;
+    std::vector<std::uint8_t> free_dof;
+    SparseRows A;
+};
+
+BoxSystem box_system(index_t nx, index_t ny, index_t nz, std::size_t fixed) {
+    BoxSystem b{make_box(nx, ny, nz), {}, {}};
+    auto op = make_reference_operator<double>(b.mesh, Materials{Material{1e5, 0.3, 1000}}, ModelKind::FE, Method::Edge);
+    std::vector<double> u(b.mesh.X.size(), 0.0), f(u.size());
+    op->forces(u.data(), f.data(), false);
+    op->build_stiffness(false);
+    const std::size_t n = b.mesh.X.size();
+    b.free_dof.assign(n, 1);
+    for (std::size_t i = 0; i < 3 * fixed; ++i) b.free_dof[i] = 0;
+    std::vector<index_t> dof;
+    const index_t nf = number_free_dofs(std::vector<std::uint8_t>(n, 1), dof);
+    b.A = assemble_system<double>(dof, nf, 0.0, {}, {{1.0, op.get()}});
+    for (Eigen::Index i = 0; i < b.A.rows(); ++i) b.A.coeffRef(i, i) += 50.0;
+    for (int k = 0; k < b.A.outerSize(); ++k)
+        for (SparseRows::InnerIterator it(b.A, k); it; ++it)
+            if (!b.free_dof[std::size_t(it.row())] || !b.free_dof[std::size_t(it.col())]) it.valueRef() = 0;
+    return b;
+}
+
+AmgSettings smoother_settings(AmgSmoother kind, int steps, int max_coarse_dofs) {
+    AmgSettings a;
+    a.smoother = kind;
+    a.smoothing_steps = steps;
+    a.max_coarse_dofs = max_coarse_dofs;
+    return a;
+}
+
+}  // namespace
+
+TEST(SmoothedAggregation, VCycleIsSymmetricAndPositiveWithEachSmoother) {
+    const BoxSystem sys = box_system(12, 6, 6, 10);
+    const SparseRows& A = sys.A;
+    const auto fine = [&](const double* x, double* y) {
+        Eigen::Map<Eigen::VectorXd>(y, A.rows()) = A * Eigen::Map<const Eigen::VectorXd>(x, A.rows());
+    };
+    Eigen::VectorXd r1(A.rows()), r2(A.rows()), z1(A.rows()), z2(A.rows());
+    for (Eigen::Index i = 0; i < A.rows(); ++i) {
+        r1[i] = sys.free_dof[std::size_t(i)] ? std::sin(1.0 + double(i)) : 0.0;
+        r2[i] = sys.free_dof[std::size_t(i)] ? std::cos(0.7 * double(i)) : 0.0;
+    }
+    for (const AmgSmoother kind : {AmgSmoother::L1Jacobi, AmgSmoother::Chebyshev})
+        for (int steps : {1, 2, 3}) {
+            SCOPED_TRACE((kind == AmgSmoother::Chebyshev ? "Chebyshev degree " : "l1 sweeps ") + std::to_string(steps));
+            SmoothedAggregation amg;
+            amg.build(A, sys.mesh.X, sys.free_dof, smoother_settings(kind, steps, 100));
+            ASSERT_GE(amg.levels(), 3);
+            amg.apply(r1.data(), z1.data(), fine);
+            amg.apply(r2.data(), z2.data(), fine);
+            // <r2, M r1> = <r1, M r2> to round-off: PCG's preconditioner must be symmetric.
+            EXPECT_NEAR(dot(r2, z1), dot(r1, z2), 1e-12 * std::sqrt(dot(r1, z1) * dot(r2, z2)));
+            EXPECT_GT(dot(r1, z1), 0);
+            EXPECT_GT(dot(r2, z2), 0);
+        }
+}
+
+// The Chebyshev smoother's error propagation E = I - S A is the polynomial
+// q(D^-1 A) = T_m((beta + alpha - 2 lambda) / (beta - alpha)) / T_m(sigma),
+// sigma = (beta + alpha) / (beta - alpha) = (ratio + 1) / (ratio - 1): on
+// the upper end of the spectrum (the error's high-frequency part, which the
+// coarse levels cannot see) it damps by 1 / T_m(sigma) at least, and it
+// never increases the error's energy norm.
+TEST(SmoothedAggregation, ChebyshevSmootherDampsTheHighFrequencyErrorByItsBound) {
+    const BoxSystem sys = box_system(10, 5, 5, 6);
+    const SparseRows& A = sys.A;
+    const Eigen::Index n = A.rows();
+    const auto fine = [&](const double* x, double* y) {
+        Eigen::Map<Eigen::VectorXd>(y, n) = A * Eigen::Map<const Eigen::VectorXd>(x, n);
+    };
+    // D^-1 A's top eigenvector by power iteration (the test's own, 400
+    // steps), D the 3x3 diagonal blocks (identity on fixed dofs).
+    std::vector<Eigen::Matrix3d> Dinv(std::size_t(n / 3));
+    for (Eigen::Index v = 0; v < n / 3; ++v) {
+        Eigen::Matrix3d D;
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) {
+                const bool live = sys.free_dof[std::size_t(3 * v + r)] && sys.free_dof[std::size_t(3 * v + c)];
+                D(r, c) = live ? A.coeff(3 * v + r, 3 * v + c) : double(r == c);
+            }
+        Dinv[std::size_t(v)] = D.inverse();
+    }
+    Eigen::VectorXd top(n), Ax(n);
+    for (Eigen::Index i = 0; i < n; ++i) top[i] = sys.free_dof[std::size_t(i)] ? std::sin(3.0 * double(i) + 0.3) : 0.0;
+    for (int k = 0; k < 400; ++k) {
+        Ax = A * top;
+        for (Eigen::Index v = 0; v < n / 3; ++v) top.segment<3>(3 * v) = Dinv[std::size_t(v)] * Ax.segment<3>(3 * v);
+        top /= std::sqrt(dot(top, top));
+    }
+    const auto energy = [&](const Eigen::VectorXd& e) { return std::sqrt(dot(e, A * e)); };
+    // E e: the smoother on A x = A e from x = 0.
+    const auto propagate = [&](const SmoothedAggregation& amg, const Eigen::VectorXd& e) {
+        const Eigen::VectorXd b = A * e;
+        Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+        amg.smooth(0, b.data(), x.data(), fine);
+        return Eigen::VectorXd(e - x);
+    };
+    Eigen::VectorXd rough(n);
+    for (Eigen::Index i = 0; i < n; ++i) rough[i] = sys.free_dof[std::size_t(i)] ? std::sin(12.9898 * double(i)) : 0.0;
+    for (int degree : {2, 3}) {
+        SCOPED_TRACE("degree " + std::to_string(degree));
+        AmgSettings set = smoother_settings(AmgSmoother::Chebyshev, degree, 60);
+        SmoothedAggregation amg;
+        amg.build(A, sys.mesh.X, sys.free_dof, set);
+        ASSERT_GE(amg.levels(), 2);
+        const double sigma = (set.chebyshev_ratio + 1) / (set.chebyshev_ratio - 1);
+        const double t = degree == 2 ? 2 * sigma * sigma - 1 : 4 * sigma * sigma * sigma - 3 * sigma;  // T_m(sigma)
+        EXPECT_LE(energy(propagate(amg, top)), (1 / t) * energy(top) * 1.001);
+        EXPECT_LT(energy(propagate(amg, rough)), energy(rough));
+        // Also the l1 block-Jacobi sweeps never increase the energy norm.
+        SmoothedAggregation l1;
+        l1.build(A, sys.mesh.X, sys.free_dof, smoother_settings(AmgSmoother::L1Jacobi, degree, 60));
+        EXPECT_LT(energy(propagate(l1, top)), energy(top));
+        EXPECT_LT(energy(propagate(l1, rough)), energy(rough));
     }
 }
 

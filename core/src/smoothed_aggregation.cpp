@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/sparse_cholesky.hpp"
@@ -140,10 +141,11 @@ std::vector<index_t> aggregate(const std::vector<std::vector<index_t>>& adj, ind
     return agg;
 }
 
-// The l1 block-Jacobi smoother's inverse blocks: (A_ii + diag(sum of |a_kj|
-// over the row's entries outside the block))^-1, dofs with a zero row left
-// out (0 in the inverse).
-std::vector<double> l1_block_inverse(const SparseRows& A, int bs) {
+// The smoothers' inverse diagonal blocks, row-major bs x bs each: A_ii^-1,
+// or with l1 the l1 block-Jacobi's (A_ii + diag(sum of |a_kj| over the
+// row's entries outside the block))^-1; dofs with a zero row left out (0 in
+// the inverse).
+std::vector<double> block_inverse(const SparseRows& A, int bs, bool l1) {
     const index_t nodes = index_t(A.rows() / bs);
     const std::size_t bb = std::size_t(bs * bs);
     std::vector<double> inv(std::size_t(nodes) * bb, 0.0), B(bb);
@@ -154,13 +156,15 @@ std::vector<double> l1_block_inverse(const SparseRows& A, int bs) {
             for (SparseRows::InnerIterator it(A, i * bs + r); it; ++it) {
                 if (it.value() != 0) live[std::size_t(r)] = true;
                 if (it.col() / bs == i) B[std::size_t(r * bs) + std::size_t(it.col() % bs)] += it.value();
-                else B[std::size_t(r * bs + r)] += std::abs(it.value());
+                else if (l1) B[std::size_t(r * bs + r)] += std::abs(it.value());
             }
         for (int r = 0; r < bs; ++r)
             if (!live[std::size_t(r)])
                 for (int c = 0; c < bs; ++c) B[std::size_t(r * bs + c)] = B[std::size_t(c * bs + r)] = r == c;
         double* out = &inv[std::size_t(i) * bb];
         invert_small(B, bs, out);
+        for (int r = 0; r < bs; ++r)  // exactly symmetric, as the V-cycle must be
+            for (int c = r + 1; c < bs; ++c) out[r * bs + c] = out[c * bs + r] = 0.5 * (out[r * bs + c] + out[c * bs + r]);
         for (int r = 0; r < bs; ++r)
             if (!live[std::size_t(r)])
                 for (int c = 0; c < bs; ++c) out[r * bs + c] = out[c * bs + r] = 0;
@@ -217,6 +221,108 @@ double spectral_radius(const SparseRows& DinvA, int iterations) {
     return lambda;
 }
 
+// y = f D^-1 v + keep y, D^-1 given by its bs x bs inverse blocks (keep 0:
+// y overwritten).
+void block_apply(const std::vector<double>& Dinv, int bs, const double* v, double* y, double f, double keep) {
+    const std::size_t bb = std::size_t(bs * bs), nodes = Dinv.size() / bb;
+    for (std::size_t i = 0; i < nodes; ++i) {
+        const double* m = &Dinv[i * bb];
+        const double* vi = v + i * std::size_t(bs);
+        double* yi = y + i * std::size_t(bs);
+        for (int a = 0; a < bs; ++a) {
+            double s = 0;
+            for (int c = 0; c < bs; ++c) s += m[a * bs + c] * vi[c];
+            yi[a] = keep == 0 ? f * s : keep * yi[a] + f * s;
+        }
+    }
+}
+
+// The largest eigenvalue of D^-1 A, D^-1 given by its inverse blocks, by
+// power iteration from a fixed start (deterministic).
+double largest_eigenvalue(const SparseRows& A, const std::vector<double>& Dinv, int bs, int iterations) {
+    const Eigen::Index n = A.rows();
+    Eigen::VectorXd x(n), Ax(n), y(n);
+    for (Eigen::Index i = 0; i < n; ++i) x[i] = 1.0 + 0.5 * std::sin(double(i));
+    double lambda = 1;
+    for (int k = 0; k < iterations; ++k) {
+        Ax = A * x;
+        block_apply(Dinv, bs, Ax.data(), y.data(), 1.0, 0.0);
+        double nx = 0, ny = 0;  // plain loops: see invert_small
+        for (Eigen::Index i = 0; i < n; ++i) {
+            nx += x[i] * x[i];
+            ny += y[i] * y[i];
+        }
+        if (!(ny > 0)) break;
+        lambda = std::sqrt(ny / nx);
+        const double s = 1 / std::sqrt(ny);
+        for (Eigen::Index i = 0; i < n; ++i) x[i] = y[i] * s;
+    }
+    return lambda;
+}
+
+// A sparse matrix kept for the V-cycle in float values and int indices
+// (row-major), half of double's 12 bytes per entry less 4: the prolongators
+// and the coarse operators. The preconditioner stays a fixed symmetric
+// operator (R = P^T reads the same rounded values; a symmetric matrix
+// rounded entrywise stays symmetric); the products accumulate in double.
+struct CompactRows {
+    Eigen::Index rows = 0, cols = 0;
+    std::vector<int> start, col;
+    std::vector<float> val;
+
+    void assign(const SparseRows& M) {
+        rows = M.rows();
+        cols = M.cols();
+        start.assign(std::size_t(rows) + 1, 0);
+        col.clear();
+        val.clear();
+        col.reserve(std::size_t(M.nonZeros()));
+        val.reserve(std::size_t(M.nonZeros()));
+        for (Eigen::Index i = 0; i < rows; ++i) {
+            for (SparseRows::InnerIterator it(M, i); it; ++it)
+                if (it.value() != 0) {
+                    col.push_back(int(it.col()));
+                    val.push_back(float(it.value()));
+                }
+            start[std::size_t(i) + 1] = int(col.size());
+        }
+    }
+    // y = M x
+    void times(const double* x, double* y) const {
+        for (Eigen::Index i = 0; i < rows; ++i) {
+            double s = 0;
+            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) s += double(val[std::size_t(k)]) * x[col[std::size_t(k)]];
+            y[i] = s;
+        }
+    }
+    // y += M x
+    void add_times(const double* x, double* y) const {
+        for (Eigen::Index i = 0; i < rows; ++i) {
+            double s = 0;
+            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) s += double(val[std::size_t(k)]) * x[col[std::size_t(k)]];
+            y[i] += s;
+        }
+    }
+    // y = M^T x
+    void transpose_times(const double* x, double* y) const {
+        std::fill(y, y + cols, 0.0);
+        for (Eigen::Index i = 0; i < rows; ++i)
+            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k)
+                y[col[std::size_t(k)]] += double(val[std::size_t(k)]) * x[i];
+    }
+    SparseRows expand() const {
+        std::vector<Eigen::Triplet<double>> t;
+        t.reserve(val.size());
+        for (Eigen::Index i = 0; i < rows; ++i)
+            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k)
+                t.emplace_back(int(i), col[std::size_t(k)], double(val[std::size_t(k)]));
+        SparseRows M(rows, cols);
+        M.setFromTriplets(t.begin(), t.end());
+        return M;
+    }
+    std::size_t bytes() const { return start.size() * sizeof(int) + col.size() * sizeof(int) + val.size() * sizeof(float); }
+};
+
 // The lower triangle of A (symmetric) with a unit diagonal on dofs whose
 // row is zero (a prolongator column without a mode: a constrained or
 // degenerate aggregate), for the coarsest factorisation.
@@ -267,30 +373,74 @@ Eigen::MatrixXd rigid_body_modes(const std::vector<double>& p) {
 struct SmoothedAggregation::Impl {
     struct Level {
         int bs = 3;
-        SparseRows A;          // level >= 1: R A P of the level above
-        SparseRows P_tent, P, R;  // to the next level
+        CompactRows A;         // level >= 1 and not the coarsest: R A P of the level above
+        CompactRows P;         // to the next level (R = P^T is not stored)
+        SparseRows P_tent;     // before smoothing (build only; release_build_data() frees it)
         Eigen::MatrixXd B;     // near-nullspace, dofs x 6
-        std::vector<double> Minv;  // l1 block-Jacobi inverse blocks
-        mutable Eigen::VectorXd x, b, r;  // V-cycle work
+        std::vector<double> Minv;  // the smoother's inverse blocks (D^-1, or l1 block-Jacobi's)
+        double lambda = 1;     // Chebyshev: the largest eigenvalue of D^-1 A
+        mutable Eigen::VectorXd x, b, r, d, t;  // V-cycle work
     };
     AmgSettings settings;
     std::vector<Level> level;
     SparseCholesky coarse;
     mutable Eigen::VectorXd coarse_rhs;
 
-    void smooth(const Level& L, const double* r, double* x, bool add) const {
-        const int bs = L.bs, bb = bs * bs;
-        const std::size_t nodes = L.Minv.size() / std::size_t(bb);
-        for (std::size_t i = 0; i < nodes; ++i) {
-            const double* m = &L.Minv[i * std::size_t(bb)];
-            const double* ri = r + i * std::size_t(bs);
-            double* xi = x + i * std::size_t(bs);
-            for (int a = 0; a < bs; ++a) {
-                double s = 0;
-                for (int c = 0; c < bs; ++c) s += m[a * bs + c] * ri[c];
-                xi[a] = add ? xi[a] + s : s;
+    // x += S (b - A x), S the smoother (zero: x = S b without a product):
+    // l1 block-Jacobi sweeps, or the Chebyshev iteration (Saad, Iterative
+    // Methods, Alg. 12.1) preconditioned by D^-1 on [beta / ratio, beta]:
+    // x += p(D^-1 A) D^-1 (b - A x), S = p(D^-1 A) D^-1 symmetric. Products
+    // with A and axpys only.
+    template <class Product>
+    void smooth(const Level& L, const double* b, double* x, bool zero, const Product& product) const {
+        const Eigen::Index n = Eigen::Index(L.Minv.size() / std::size_t(L.bs));
+        const int steps = settings.smoothing_steps;
+        L.r.resize(n);
+        const auto residual = [&] {
+            product(x, L.r.data());
+            for (Eigen::Index i = 0; i < n; ++i) L.r[i] = b[i] - L.r[i];
+        };
+        if (settings.smoother == AmgSmoother::L1Jacobi) {
+            for (int s = 0; s < steps; ++s) {
+                if (s == 0 && zero) {
+                    block_apply(L.Minv, L.bs, b, x, 1.0, 0.0);
+                    continue;
+                }
+                residual();
+                block_apply(L.Minv, L.bs, L.r.data(), x, 1.0, 1.0);
             }
+            return;
         }
+        const double beta = 1.1 * L.lambda, alpha = beta / settings.chebyshev_ratio;
+        const double theta = (beta + alpha) / 2, delta = (beta - alpha) / 2, sigma = theta / delta;
+        double rho = 1 / sigma;
+        if (zero) {
+            std::fill(x, x + n, 0.0);
+            std::copy(b, b + n, L.r.data());
+        } else {
+            residual();
+        }
+        L.d.resize(n);
+        L.t.resize(n);
+        block_apply(L.Minv, L.bs, L.r.data(), L.d.data(), 1 / theta, 0.0);
+        for (int k = 1;; ++k) {
+            for (Eigen::Index i = 0; i < n; ++i) x[i] += L.d[i];
+            if (k == steps) break;
+            product(L.d.data(), L.t.data());
+            L.r -= L.t;
+            const double rho_next = 1 / (2 * sigma - rho);
+            block_apply(L.Minv, L.bs, L.r.data(), L.d.data(), 2 * rho_next / delta, rho_next * rho);
+            rho = rho_next;
+        }
+    }
+
+    // out = A_l in: the caller's product on the finest level.
+    auto product(std::size_t l, const std::function<void(const double*, double*)>& fine) const {
+        return [this, l, &fine](const double* in, double* out) {
+            const Level& L = level[l];
+            if (l == 0) fine(in, out);
+            else L.A.times(in, out);
+        };
     }
 
     // x = V-cycle(b) on level l (x overwritten).
@@ -301,30 +451,17 @@ struct SmoothedAggregation::Impl {
             coarse.solve(b, x);
             return;
         }
-        const auto product = [&](const double* in, double* out) {
-            if (l == 0) fine(in, out);
-            else Eigen::Map<Eigen::VectorXd>(out, n) = L.A * Eigen::Map<const Eigen::VectorXd>(in, n);
-        };
-        L.r.resize(n);
-        const auto residual = [&] {
-            product(x, L.r.data());
-            for (Eigen::Index i = 0; i < n; ++i) L.r[i] = b[i] - L.r[i];
-        };
-        smooth(L, b, x, false);
-        for (int s = 1; s < settings.smoothing_steps; ++s) {
-            residual();
-            smooth(L, L.r.data(), x, true);
-        }
-        residual();
+        const auto product = this->product(l, fine);
+        smooth(L, b, x, true, product);
+        product(x, L.r.data());
+        for (Eigen::Index i = 0; i < n; ++i) L.r[i] = b[i] - L.r[i];
         const Level& C = level[l + 1];
-        C.b = L.R * L.r;
+        C.b.resize(L.P.cols);
+        L.P.transpose_times(L.r.data(), C.b.data());
         C.x.resize(C.b.size());
         cycle(l + 1, C.b.data(), C.x.data(), fine);
-        Eigen::Map<Eigen::VectorXd>(x, n) += L.P * C.x;
-        for (int s = 0; s < settings.smoothing_steps; ++s) {
-            residual();
-            smooth(L, L.r.data(), x, true);
-        }
+        L.P.add_times(C.x.data(), x);
+        smooth(L, b, x, false, product);
     }
 };
 
@@ -336,6 +473,11 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
     if (A.rows() != A.cols() || A.rows() % 3 != 0 || std::size_t(A.rows()) != rest.size() ||
         free_dof.size() != rest.size())
         throw InvalidArgument("SmoothedAggregation::build: A must be 3 #V square with 3 #V coordinates and free flags");
+    if (settings.max_coarse_dofs < 1 || settings.max_levels < 1 || settings.smoothing_steps < 1 ||
+        settings.power_iterations < 1 || !(settings.chebyshev_ratio > 1) || !(settings.prolongator_weight >= 0) ||
+        !(settings.strength >= 0))
+        throw InvalidArgument("AmgSettings: max_coarse_dofs, max_levels, smoothing_steps and power_iterations must be "
+                              ">= 1, chebyshev_ratio > 1, prolongator_weight and strength >= 0");
     Impl& m = *impl_;
     m.settings = settings;
     m.level.clear();
@@ -352,7 +494,7 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         index_t count = 0;
         // The finest level aggregates on the whole edge graph; coarser ones
         // on their strong couplings only.
-        const std::vector<index_t> agg = aggregate(node_graph(Al, bs, m.level.size() == 1 ? 0.0 : 0.08), count);
+        const std::vector<index_t> agg = aggregate(node_graph(Al, bs, m.level.size() == 1 ? 0.0 : settings.strength), count);
         if (Eigen::Index(count) * kModes >= Al.rows()) break;  // no coarsening left
         // Tentative prolongator: per aggregate, B's rows = Q R (thin QR).
         std::vector<std::vector<index_t>> members{std::size_t(count)};
@@ -384,14 +526,14 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         }
         L.P_tent.resize(Al.rows(), Eigen::Index(count) * kModes);
         L.P_tent.setFromTriplets(t.begin(), t.end());
-        // Smoothed: P = (I - 4 / (3 rho) D^-1 A) P_tent.
+        // Smoothed: P = (I - w / rho D^-1 A) P_tent (w = 4/3 by default).
         const SparseRows Dinv = block_diagonal_inverse(Al, bs);
         const SparseRows DinvA = Dinv * Al;
         const double rho = spectral_radius(DinvA, settings.power_iterations);
-        L.P = L.P_tent - (4.0 / (3.0 * rho)) * SparseRows(DinvA * L.P_tent);
-        L.P.prune(0.0);
-        L.R = L.P.transpose();
-        SparseRows Ac = L.R * Al * L.P;
+        const SparseRows P = L.P_tent - (settings.prolongator_weight / rho) * SparseRows(DinvA * L.P_tent);
+        L.P.assign(P);
+        const SparseRows Pf = L.P.expand();  // the rounded P, as refresh() and apply() use it
+        SparseRows Ac = SparseRows(Pf.transpose()) * Al * Pf;
         m.level.emplace_back();
         m.level.back().bs = kModes;
         m.level.back().B = Bc;
@@ -404,14 +546,20 @@ void SmoothedAggregation::refresh(const SparseRows& A) {
     Impl& m = *impl_;
     if (m.level.empty()) throw InvalidArgument("SmoothedAggregation::refresh: build() first");
     const SparseRows* Al = &A;
+    SparseRows Acur;  // the Galerkin operator of level l, in double while the next is formed
     for (std::size_t l = 0; l < m.level.size(); ++l) {
         Impl::Level& L = m.level[l];
         if (l > 0) {
-            L.A = m.level[l - 1].R * (*Al * m.level[l - 1].P);
-            Al = &L.A;
+            const SparseRows P = m.level[l - 1].P.expand();
+            SparseRows next = SparseRows(P.transpose()) * (*Al * P);
+            Acur = std::move(next);
+            Al = &Acur;
         }
         if (l + 1 < m.level.size()) {
-            L.Minv = l1_block_inverse(*Al, L.bs);
+            if (l > 0) L.A.assign(*Al);
+            const bool cheb = m.settings.smoother == AmgSmoother::Chebyshev;
+            L.Minv = block_inverse(*Al, L.bs, !cheb);
+            if (cheb) L.lambda = largest_eigenvalue(*Al, L.Minv, L.bs, m.settings.power_iterations);
         } else {
             L.Minv.assign(std::size_t(Al->rows()) * std::size_t(L.bs), 0.0);  // sizes only
             if (!m.coarse.factor(lower_with_unit_dead(*Al)))
@@ -424,20 +572,40 @@ void SmoothedAggregation::apply(const double* r, double* z, const std::function<
     impl_->cycle(0, r, z, fine);
 }
 
+void SmoothedAggregation::smooth(int l, const double* b, double* x,
+                                 const std::function<void(const double*, double*)>& fine) const {
+    const Impl& m = *impl_;
+    if (l < 0 || std::size_t(l) + 1 >= m.level.size())
+        throw InvalidArgument("SmoothedAggregation::smooth: level " + std::to_string(l) + " has no smoother");
+    m.smooth(m.level[std::size_t(l)], b, x, false, m.product(std::size_t(l), fine));
+}
+
 int SmoothedAggregation::levels() const { return int(impl_->level.size()); }
-index_t SmoothedAggregation::dofs(int l) const { return index_t(impl_->level[std::size_t(l)].B.rows()); }
+index_t SmoothedAggregation::dofs(int l) const {
+    const auto& L = impl_->level[std::size_t(l)];
+    return index_t(L.Minv.size() / std::size_t(L.bs));
+}
 const SparseRows& SmoothedAggregation::tentative(int l) const { return impl_->level[std::size_t(l)].P_tent; }
-const SparseRows& SmoothedAggregation::prolongator(int l) const { return impl_->level[std::size_t(l)].P; }
+SparseRows SmoothedAggregation::prolongator(int l) const { return impl_->level[std::size_t(l)].P.expand(); }
 const Eigen::MatrixXd& SmoothedAggregation::near_nullspace(int l) const { return impl_->level[std::size_t(l)].B; }
-const SparseRows& SmoothedAggregation::matrix(int l) const { return impl_->level[std::size_t(l)].A; }
+SparseRows SmoothedAggregation::matrix(int l) const { return impl_->level[std::size_t(l)].A.expand(); }
+
+void SmoothedAggregation::release_build_data() {
+    for (auto& L : impl_->level) {
+        L.P_tent = SparseRows();
+        L.B = Eigen::MatrixXd();
+    }
+}
 
 std::size_t SmoothedAggregation::bytes() const {
     const auto sp = [](const SparseRows& M) {
         return std::size_t(M.nonZeros()) * (sizeof(double) + sizeof(int)) + std::size_t(M.outerSize() + 1) * sizeof(int);
     };
+    const auto vec = [](const Eigen::VectorXd& v) { return std::size_t(v.size()) * sizeof(double); };
     std::size_t b = 0;
     for (const auto& L : impl_->level)
-        b += sp(L.A) + sp(L.P) + sp(L.R) + L.Minv.size() * sizeof(double) + 3 * std::size_t(L.B.rows()) * sizeof(double);
+        b += L.A.bytes() + L.P.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
+             L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t);
     b += std::size_t(impl_->coarse.factor_nonzeros() * sizeof(double));
     return b;
 }

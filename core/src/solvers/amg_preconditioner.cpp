@@ -1,8 +1,9 @@
 // The AMG preconditioner: SmoothedAggregation (smoothed_aggregation.hpp) on
 // A = c_m M + c_k K (+ c_b K0). The hierarchy (aggregates, prolongators) is
 // built at the first set-up from the rest shape and the edge graph and kept;
-// a refresh assembles A into its fixed pattern (SystemMatrix) and recomputes
-// the Galerkin operators, smoothers and the coarsest factorisation: at every
+// a refresh assembles A into its fixed pattern (SystemMatrix, whose values
+// are freed again afterwards) and recomputes the Galerkin operators,
+// smoothers and the coarsest factorisation: at every
 // amg_refresh_interval-th K, or (0) lagged while CG's iterations stay within
 // 1.5x + 2 of those after the last refresh and the coefficients (the step
 // size) are unchanged. The finest level's products are the LinearSystem's
@@ -34,13 +35,15 @@ public:
         if (built_ && !due) return;
         matrix_.assemble(A);
         if (!built_) {
-            amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host);
+            amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host, s_.scene.solver.amg);
+            amg_.release_build_data();
             built_at_.record(s_, A);
             refreshed_at_.valid = false;
         } else {
             amg_.refresh(matrix_.projected());
             refreshed_at_.record(s_, A);
         }
+        matrix_.release();  // assembled again at the next refresh
         built_ = true;
         c_ = c;
         age_ = 0;
@@ -78,11 +81,14 @@ public:
         std::unique_ptr<ElasticOperator<S>> k0;
         built_at_.rebuild(s_, A, k0);
         matrix_.assemble(A);
-        amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host);
+        amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host, s_.scene.solver.amg);
+        amg_.release_build_data();
+        matrix_.release();
         if (!refreshed_at_.valid) return;
         refreshed_at_.rebuild(s_, A, k0);
         matrix_.assemble(A);
         amg_.refresh(matrix_.projected());
+        matrix_.release();
     }
 
     bool whole_vector() const override { return true; }

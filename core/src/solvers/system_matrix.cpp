@@ -48,8 +48,8 @@ void SystemMatrix<S>::find_pattern(const LinearSystem<S>& A) {
         col_[k] = pairs[k].second;
     }
     for (std::size_t v = 0; v < nv; ++v) row_start_[v + 1] += row_start_[v];
-    block_.assign(9 * pairs.size(), 0.0);
 
+    if (!want_lower_) return;
     // Lower triangle on the free dofs: column j = free dof (a, r) holds the
     // free dofs i >= j of row j (A is symmetric), in increasing order.
     const auto& fr = s_.free_host;
@@ -74,8 +74,12 @@ void SystemMatrix<S>::find_pattern(const LinearSystem<S>& A) {
             lower_.col_start.push_back(index_t(lower_.row.size()));
         }
     lower_.value.assign(lower_.row.size(), 0.0);
+}
 
-    // The projected matrix's pattern: every block's 9 entries.
+// The projected matrix's pattern: every block's 9 entries.
+template <class S>
+void SystemMatrix<S>::projected_pattern() {
+    const std::size_t nv = s_.mass_host.size();
     const index_t n = index_t(3 * nv);
     projected_.resize(n, n);
     std::vector<int> per_row(static_cast<std::size_t>(n));
@@ -93,7 +97,7 @@ void SystemMatrix<S>::find_pattern(const LinearSystem<S>& A) {
 template <class S>
 void SystemMatrix<S>::assemble(const LinearSystem<S>& A) {
     if (row_start_.empty()) find_pattern(A);
-    std::fill(block_.begin(), block_.end(), 0.0);
+    block_.assign(9 * col_.size(), 0.0);
     const std::size_t nv = s_.mass_host.size();
     for (std::size_t v = 0; v < nv; ++v) {
         const auto first = col_.begin() + row_start_[v], last = col_.begin() + row_start_[v + 1];
@@ -110,6 +114,7 @@ void SystemMatrix<S>::assemble(const LinearSystem<S>& A) {
     if (want_lower_)
         for (std::size_t e = 0; e < lower_src_.size(); ++e) lower_.value[e] = block_[lower_src_[e]];
     if (want_projected_) {
+        if (projected_.nonZeros() == 0) projected_pattern();
         const auto& fr = s_.free_host;
         double* val = projected_.valuePtr();
         std::size_t e = 0;
@@ -123,6 +128,12 @@ void SystemMatrix<S>::assemble(const LinearSystem<S>& A) {
                     }
             }
     }
+}
+
+template <class S>
+void SystemMatrix<S>::release() {
+    std::vector<double>().swap(block_);
+    projected_ = Eigen::SparseMatrix<double, Eigen::RowMajor>();
 }
 
 template <class S>

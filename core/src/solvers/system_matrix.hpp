@@ -31,11 +31,15 @@ public:
         want_lower_ = lower;
         want_projected_ = projected;
     }
+    // Frees the values and the derived forms (the vertex-block pattern
+    // stays); the next assemble() makes them again.
+    void release();
     // Bytes held (pattern, blocks, the derived forms).
     std::size_t bytes() const;
 
 private:
     void find_pattern(const LinearSystem<S>& A);
+    void projected_pattern();
 
     const SimState<S>& s_;
     bool want_lower_ = true, want_projected_ = false;

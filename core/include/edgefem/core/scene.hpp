@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "edgefem/core/amg_settings.hpp"
 #include "edgefem/core/edge_model.hpp"
 #include "edgefem/core/elastic_operator.hpp"
 #include "edgefem/core/material.hpp"
@@ -67,6 +68,7 @@ struct SolverSettings {
     // last refresh, and on every change of the step size; N >= 1: every N-th
     // K (1: every K). docs/solvers.md has the measurements.
     int amg_refresh_interval = 0;
+    AmgSettings amg;  // the hierarchy and smoother (amg_settings.hpp); C++ only
     double cg_tolerance = 1e-6;   // relative residual |r| / |b| of the projected system
     int cg_max_iterations = 500;
     int cg_fixed_iterations = 0;  // > 0: exactly this many warm-started iterations (haptic budget)

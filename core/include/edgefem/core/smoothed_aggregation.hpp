@@ -3,9 +3,10 @@
 // coarse ones), the near-nullspace is the six rigid-body modes of the rest
 // shape. build() forms the aggregates (greedy, on the matrix's block graph)
 // and the prolongators P = (I - w D^-1 A) P_tent once; refresh() recomputes
-// the Galerkin operators R A P, the l1 block-Jacobi smoothers and the
-// coarsest factorisation (CHOLMOD, its analysis reused) for a new A of the
-// same pattern; apply() runs one symmetric V-cycle, the finest level's
+// the Galerkin operators R A P, the smoothers (Chebyshev in D^-1 A or l1
+// block-Jacobi) and the coarsest factorisation (CHOLMOD, its analysis
+// reused) for a new A of the same pattern; apply() runs one symmetric
+// V-cycle (the smoothers are symmetric and only products and axpys), the finest level's
 // products through a caller's function (the matrix-free per-edge K). On the
 // host, serial apart from the caller's product.
 #pragma once
@@ -16,18 +17,12 @@
 #include <memory>
 #include <vector>
 
+#include "edgefem/core/amg_settings.hpp"
 #include "edgefem/core/mesh.hpp"
 
 namespace edgefem {
 
 using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
-
-struct AmgSettings {
-    int max_coarse_dofs = 250;   // the coarsest level is factorised (densely filled) once it has at most this many dofs
-    int max_levels = 8;
-    int smoothing_steps = 1;     // l1 block-Jacobi sweeps before and after the coarse correction
-    int power_iterations = 12;   // for the prolongator smoother's spectral radius
-};
 
 class SmoothedAggregation {
 public:
@@ -45,14 +40,20 @@ public:
     // z = one V-cycle applied to r (n each, zero on constrained dofs);
     // fine(x, y): y = A x with constrained entries of y zero.
     void apply(const double* r, double* z, const std::function<void(const double*, double*)>& fine) const;
+    // x += S (b - A_level x): one application of level's smoother (not on the
+    // coarsest), the one the V-cycle runs before and after its correction.
+    void smooth(int level, const double* b, double* x, const std::function<void(const double*, double*)>& fine) const;
 
     int levels() const;                                // including the finest
     index_t dofs(int level) const;
     const SparseRows& tentative(int level) const;      // level -> level + 1, before smoothing
-    const SparseRows& prolongator(int level) const;
+    SparseRows prolongator(int level) const;           // as apply() uses it (float values)
     const Eigen::MatrixXd& near_nullspace(int level) const;  // dofs(level) x 6
-    const SparseRows& matrix(int level) const;         // level >= 1 (level 0: the caller's)
-    std::size_t bytes() const;                         // what apply() and refresh() keep
+    SparseRows matrix(int level) const;                // 1 <= level < levels() - 1 (level 0: the caller's; the coarsest: factorised)
+    // Frees what only build() and the accessors above need (the tentative
+    // prolongators, the near-nullspace): refresh() and apply() go on.
+    void release_build_data();
+    std::size_t bytes() const;                         // what is held (after release_build_data(): what apply() and refresh() need)
 
 private:
     struct Impl;

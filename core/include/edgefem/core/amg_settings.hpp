@@ -1,0 +1,32 @@
+// The smoothed-aggregation AMG's parameters (smoothed_aggregation.hpp;
+// docs/solvers.md has the measurements behind the defaults). Plain data, so
+// that SolverSettings can hold them without the AMG's headers.
+#pragma once
+
+namespace edgefem {
+
+enum class AmgSmoother {
+    Chebyshev,  // a Chebyshev polynomial in D^-1 A (D: the diagonal blocks), degree smoothing_steps
+    L1Jacobi,   // smoothing_steps sweeps of l1 block-Jacobi
+};
+
+struct AmgSettings {
+    int max_coarse_dofs = 250;   // the coarsest level is factorised (densely filled) once it has at most this many dofs
+    int max_levels = 8;
+    // Before and after the coarse correction: the Chebyshev degree or the
+    // number of l1 sweeps; either costs 2 x smoothing_steps products with
+    // the level's matrix per V-cycle.
+    int smoothing_steps = 1;
+    int power_iterations = 12;   // for the largest eigenvalue of D^-1 A (prolongator smoother, Chebyshev)
+    AmgSmoother smoother = AmgSmoother::L1Jacobi;
+    // Chebyshev: the polynomial damps the eigenvalues of D^-1 A in
+    // [lambda_max / chebyshev_ratio, 1.1 lambda_max].
+    double chebyshev_ratio = 30;
+    // The prolongator smoother P = (I - w / lambda_max D^-1 A) P_tent.
+    double prolongator_weight = 4.0 / 3.0;
+    // Coarse levels aggregate over couplings with |A_ij|_F^2 > strength^2
+    // |A_ii|_F |A_jj|_F (the finest level over the whole edge graph).
+    double strength = 0.08;
+};
+
+}  // namespace edgefem
