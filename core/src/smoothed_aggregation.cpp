@@ -172,53 +172,18 @@ std::vector<double> block_inverse(const SparseRows& A, int bs, bool l1) {
     return inv;
 }
 
-// The block-diagonal matrix of D's inverse blocks (plain block Jacobi; zero
-// blocks' dofs left out).
-SparseRows block_diagonal_inverse(const SparseRows& A, int bs) {
-    const index_t nodes = index_t(A.rows() / bs);
+// The block-diagonal sparse matrix of inverse blocks (block_inverse's).
+SparseRows block_diagonal(const std::vector<double>& Dinv, int bs, Eigen::Index n) {
     std::vector<Eigen::Triplet<double>> t;
-    std::vector<double> B(static_cast<std::size_t>(bs * bs));
-    for (index_t i = 0; i < nodes; ++i) {
-        std::fill(B.begin(), B.end(), 0.0);
+    const std::size_t bb = std::size_t(bs * bs);
+    for (std::size_t i = 0; i < Dinv.size() / bb; ++i)
         for (int r = 0; r < bs; ++r)
-            for (SparseRows::InnerIterator it(A, i * bs + r); it; ++it)
-                if (it.col() / bs == i) B[std::size_t(r * bs) + std::size_t(it.col() % bs)] = it.value();
-        std::vector<int> live;
-        for (int r = 0; r < bs; ++r)
-            if (B[std::size_t(r * bs + r)] != 0) live.push_back(r);
-        const int m = int(live.size());
-        std::vector<double> S(std::size_t(m * m)), Si(std::size_t(m * m));
-        for (int a = 0; a < m; ++a)
-            for (int b = 0; b < m; ++b) S[std::size_t(a * m + b)] = B[std::size_t(live[std::size_t(a)] * bs + live[std::size_t(b)])];
-        if (m > 0) invert_small(S, m, Si.data());
-        for (int a = 0; a < m; ++a)
-            for (int b = 0; b < m; ++b)
-                t.emplace_back(i * bs + live[std::size_t(a)], i * bs + live[std::size_t(b)], Si[std::size_t(a * m + b)]);
-    }
-    SparseRows D(A.rows(), A.cols());
+            for (int c = 0; c < bs; ++c)
+                if (const double v = Dinv[i * bb + std::size_t(r * bs + c)]; v != 0)
+                    t.emplace_back(int(i) * bs + r, int(i) * bs + c, v);
+    SparseRows D(n, n);
     D.setFromTriplets(t.begin(), t.end());
     return D;
-}
-
-// The largest eigenvalue of D^-1 A by power iteration (a fixed start, so
-// the hierarchy is deterministic).
-double spectral_radius(const SparseRows& DinvA, int iterations) {
-    const auto norm = [](const Eigen::VectorXd& v) {  // a plain loop: see invert_small
-        double s = 0;
-        for (Eigen::Index i = 0; i < v.size(); ++i) s += v[i] * v[i];
-        return std::sqrt(s);
-    };
-    Eigen::VectorXd x(DinvA.rows()), y;
-    for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = 1.0 + 0.5 * std::sin(double(i));
-    double lambda = 1;
-    for (int k = 0; k < iterations; ++k) {
-        y = DinvA * x;
-        const double nx = norm(x), ny = norm(y);
-        if (!(ny > 0)) break;
-        lambda = ny / nx;
-        for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = y[i] / ny;
-    }
-    return lambda;
 }
 
 // y = f D^-1 v + keep y, D^-1 given by its bs x bs inverse blocks (keep 0:
@@ -287,20 +252,12 @@ struct CompactRows {
             start[std::size_t(i) + 1] = int(col.size());
         }
     }
-    // y = M x
-    void times(const double* x, double* y) const {
+    // y = M x, or y += M x with accumulate
+    void times(const double* x, double* y, bool accumulate = false) const {
         for (Eigen::Index i = 0; i < rows; ++i) {
             double s = 0;
             for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) s += double(val[std::size_t(k)]) * x[col[std::size_t(k)]];
-            y[i] = s;
-        }
-    }
-    // y += M x
-    void add_times(const double* x, double* y) const {
-        for (Eigen::Index i = 0; i < rows; ++i) {
-            double s = 0;
-            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) s += double(val[std::size_t(k)]) * x[col[std::size_t(k)]];
-            y[i] += s;
+            y[i] = accumulate ? y[i] + s : s;
         }
     }
     // y = M^T x
@@ -460,7 +417,7 @@ struct SmoothedAggregation::Impl {
         L.P.transpose_times(L.r.data(), C.b.data());
         C.x.resize(C.b.size());
         cycle(l + 1, C.b.data(), C.x.data(), fine);
-        L.P.add_times(C.x.data(), x);
+        L.P.times(C.x.data(), x, true);
         smooth(L, b, x, false, product);
     }
 };
@@ -527,9 +484,9 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         L.P_tent.resize(Al.rows(), Eigen::Index(count) * kModes);
         L.P_tent.setFromTriplets(t.begin(), t.end());
         // Smoothed: P = (I - w / rho D^-1 A) P_tent (w = 4/3 by default).
-        const SparseRows Dinv = block_diagonal_inverse(Al, bs);
-        const SparseRows DinvA = Dinv * Al;
-        const double rho = spectral_radius(DinvA, settings.power_iterations);
+        const std::vector<double> Dinv = block_inverse(Al, bs, false);
+        const SparseRows DinvA = block_diagonal(Dinv, bs, Al.rows()) * Al;
+        const double rho = largest_eigenvalue(Al, Dinv, bs, settings.power_iterations);
         const SparseRows P = L.P_tent - (settings.prolongator_weight / rho) * SparseRows(DinvA * L.P_tent);
         L.P.assign(P);
         const SparseRows Pf = L.P.expand();  // the rounded P, as refresh() and apply() use it

@@ -16,12 +16,12 @@ struct AmgSettings {
     // Before and after the coarse correction: the Chebyshev degree or the
     // number of l1 sweeps; either costs 2 x smoothing_steps products with
     // the level's matrix per V-cycle.
-    int smoothing_steps = 1;
+    int smoothing_steps = 2;
     int power_iterations = 12;   // for the largest eigenvalue of D^-1 A (prolongator smoother, Chebyshev)
-    AmgSmoother smoother = AmgSmoother::L1Jacobi;
+    AmgSmoother smoother = AmgSmoother::Chebyshev;
     // Chebyshev: the polynomial damps the eigenvalues of D^-1 A in
     // [lambda_max / chebyshev_ratio, 1.1 lambda_max].
-    double chebyshev_ratio = 30;
+    double chebyshev_ratio = 10;
     // The prolongator smoother P = (I - w / lambda_max D^-1 A) P_tent.
     double prolongator_weight = 4.0 / 3.0;
     // Coarse levels aggregate over couplings with |A_ij|_F^2 > strength^2
