@@ -15,6 +15,7 @@ packages=(
   libbenchmark-dev    # benchmarks
   libcli11-dev        # command-line parsing
   nlohmann-json3-dev  # scene files
+  zlib1g-dev          # compressed binary VTU output
   python3-getfem      # tests: GetFEM reference for `edgefem static` (system python3)
   libfmt-dev
   pybind11-dev        # Python bindings (build/python/edgefem/_edgefem*.so)

@@ -1,4 +1,5 @@
-// VTU / PVD output: write small meshes, parse the numbers back.
+// VTU / PVD output: write small meshes as ASCII, parse the numbers back
+// (the binary form against these: test_vtu_output.cpp).
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -70,7 +71,7 @@ TEST(write_vtu, FieldsRoundTrip) {
     fields.force = f.data();
     fields.energy_density = energy.data();
     const std::string path = dir.file("frame.vtu");
-    write_vtu(path, m, fields);
+    write_vtu(path, m, fields, VtuFormat::Ascii);
 
     const std::string xml = slurp(path);
     EXPECT_TRUE(contains(xml, "<VTKFile type=\"UnstructuredGrid\""));
@@ -94,7 +95,7 @@ TEST(write_vtu, RestPositionsWithoutFields) {
     edgefem::test::TempDir dir("vtu0");
     const Mesh box = make_box(10, 5, 4);
     const std::string path = dir.file("box.vtu");
-    write_vtu(path, box);
+    write_vtu(path, box, {}, VtuFormat::Ascii);
     const std::string xml = slurp(path);
     EXPECT_TRUE(contains(xml, "NumberOfPoints=\"330\""));
     EXPECT_TRUE(contains(xml, "NumberOfCells=\"1200\""));
@@ -188,7 +189,7 @@ std::vector<std::string> files_in(const std::string& dir) {
 // broken XML and every frame unreachable.
 TEST(write_vtu, FailedWritesLeaveNoPartialFiles) {
     edgefem::test::TempDir dir("vtufull");
-    const Mesh box = make_box(10, 10, 10);  // a frame of about 200 kB
+    const Mesh box = make_box(10, 10, 10);  // an ASCII frame of about 200 kB
     const std::string pvd = dir.file("s.pvd");
     {
         PvdSeries series(pvd);
@@ -200,7 +201,7 @@ TEST(write_vtu, FailedWritesLeaveNoPartialFiles) {
     const int status = with_file_size_limit(64 * 1024, [&] {
         bool vtu_failed = false, pvd_failed = false;
         try {
-            write_vtu(dir.file("big.vtu"), box);
+            write_vtu(dir.file("big.vtu"), box, {}, VtuFormat::Ascii);
         } catch (const IoError& e) {
             vtu_failed = contains(e.what(), dir.file("big.vtu")) && e.path() == dir.file("big.vtu") &&
                          contains(e.what(), "too large");

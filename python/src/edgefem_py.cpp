@@ -403,17 +403,25 @@ PYBIND11_MODULE(_edgefem, m) {
     // ---- output ----
     m.def(
         "write_vtu",
-        [](const std::string& path, const Mesh& mesh, py::object displacement, py::object force) {
+        [](const std::string& path, const Mesh& mesh, py::object displacement, py::object force, py::object velocity,
+           const std::string& format) {
+            if (format != "binary" && format != "ascii")
+                throw InvalidArgument("write_vtu: format: expected 'binary' or 'ascii', got '" + printable(format) + "'");
             VtuFields f;
             // Not required finite: a blown-up state may be written to look at.
-            InArray u, fo;
+            InArray u, fo, v;
             if (!displacement.is_none())
                 u = vectors_arg(displacement, "displacement", mesh.num_vertices(), false), f.displacement = u.data();
             if (!force.is_none()) fo = vectors_arg(force, "force", mesh.num_vertices(), false), f.force = fo.data();
-            write_vtu(path, mesh, f);  // checks the connectivity before writing
+            if (!velocity.is_none())
+                v = vectors_arg(velocity, "velocity", mesh.num_vertices(), false), f.velocity = v.data();
+            // checks the connectivity before writing
+            write_vtu(path, mesh, f, format == "ascii" ? VtuFormat::Ascii : VtuFormat::Binary);
         },
         py::arg("path"), py::arg("mesh"), py::arg("displacement") = py::none(), py::arg("force") = py::none(),
-        "Writes a VTK .vtu frame (points X + displacement).");
+        py::arg("velocity") = py::none(), py::arg("format") = "binary",
+        "Writes a VTK .vtu frame (points X + displacement): format 'binary' (zlib-compressed appended data, the "
+        "default) or 'ascii'.");
     py::class_<PvdSeries>(m, "PvdSeries", "A .pvd series: add(time, vtu_path) per frame; written on write()/close.")
         .def(py::init<std::string>(), py::arg("pvd_path"))
         .def("add", &PvdSeries::add, py::arg("time"), py::arg("vtu_path"))
@@ -629,7 +637,7 @@ PYBIND11_MODULE(_edgefem, m) {
                 return s.last_stats();
             },
             py::arg("steps"), "step() `steps` times; returns the last step's stats.")
-        .def("solve_static", &Sim::solve_static, py::call_guard<py::gil_scoped_release>())
+        .def("solve_static", [](Sim& s) { return s.solve_static(); }, py::call_guard<py::gil_scoped_release>())
         .def("save_checkpoint", &Sim::save_checkpoint, py::arg("path"), py::call_guard<py::gil_scoped_release>(),
              "Writes the whole state to `path`, whole or not at all (docs/api.md, \"Checkpoints\"); raises "
              "edgefem.Error naming the file when it cannot be written.")

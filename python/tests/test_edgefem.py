@@ -255,7 +255,7 @@ def test_vtu_series(tmp_path):
             path = str(tmp_path / f"s_{k}.vtu")
             edgefem.write_vtu(path, mesh, displacement=u * k)
             pvd.add(0.1 * k, path)
-    assert (tmp_path / "s_1.vtu").read_text().count("<Piece") == 1
+    assert (tmp_path / "s_1.vtu").read_bytes().count(b"<Piece") == 1
     assert (tmp_path / "s.pvd").read_text().count("<DataSet") == 2
 
 

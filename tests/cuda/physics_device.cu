@@ -8,6 +8,7 @@
 #include "edgefem/physics/edge_g.hpp"
 #include "edgefem/physics/edge_stiffness.hpp"
 #include "edgefem/physics/edge_strain.hpp"
+#include "edgefem/physics/stress_measures.hpp"
 #include "edgefem/physics/tet_local_form.hpp"
 #include "edgefem/physics/tet_stvk.hpp"
 #include "edgefem/physics/tsep_stiffness.hpp"
@@ -63,7 +64,11 @@ __global__ void tet_formulas(int n, const S* u, const S* dinv, S* out) {
     const auto coef = [&](int a, int b) { return a == b ? S(0) : Dinv[a % 3][b % 3]; };
     physics::form_w<S>(coef, p, W);
     physics::form_block<S>(t % 6, p, W, kv);
-    out[t] = d.energy + f[0][0] + y[1][2] + physics::tet_stiffness_entry(k, 0, 1, 2, 0) + Kt[t % 90] + kv[4] + physics::form_g(t % 6, coef, zeta);
+    S G[3][3], S2[3][3], sigma[3][3];  // the output fields' measures
+    physics::green_strain<S>(d.H, G);
+    physics::stvk_stress(G, S(1), S(2), S2);
+    physics::cauchy_stress<S>(d.H, S2, sigma);
+    out[t] = physics::von_mises<S>(sigma) + d.energy + f[0][0] + y[1][2] + physics::tet_stiffness_entry(k, 0, 1, 2, 0) + Kt[t % 90] + kv[4] + physics::form_g(t % 6, coef, zeta);
 }
 
 template __global__ void edge_formulas<double>(int, const double*, const double*, const double*, double*);

@@ -10,14 +10,28 @@
 
 namespace edgefem {
 
-// Optional fields; a null pointer leaves the field out.
+// Binary (the default): every array zlib-compressed into the file's
+// appended raw data (vtkZLibDataCompressor's blocks, UInt64 headers), about
+// a quarter of the ASCII size; the doubles are the in-memory values bit for
+// bit. Ascii: numbers in shortest round-trip form (also exact), diffable.
+enum class VtuFormat { Binary, Ascii };
+
+// Optional fields; a null pointer leaves the field out. Point fields have 3
+// values per point, cell fields 1 (scalars) or 6 (symmetric tensors, in
+// VTK's order XX, YY, ZZ, XY, YZ, XZ) per cell.
 struct VtuFields {
-    const double* displacement = nullptr;    // 3 * #V; written as "displacement"
-    const double* force = nullptr;           // 3 * #V; written as "force"
-    const double* energy_density = nullptr;  // #T strain energy per rest volume (J/m^3)
-    // #V: each vertex's 0-based index in the mesh file's vertex order, when
-    // the numbering differs from it (mesh_options.compact removed vertices);
-    // written as the point field "file_vertex".
+    const double* displacement = nullptr;    // point; written as "displacement"
+    const double* velocity = nullptr;        // point; "velocity"
+    const double* force = nullptr;           // point; "force"
+    const double* normals = nullptr;         // point; "normals" (surfaces)
+    const double* energy_density = nullptr;  // cell: strain energy per rest volume (J/m^3)
+    const double* green_strain = nullptr;    // cell, 6: the Green strain E
+    const double* pk2_stress = nullptr;      // cell, 6: the second Piola-Kirchhoff stress (Pa)
+    const double* von_mises = nullptr;       // cell: von Mises stress of the Cauchy stress (Pa)
+    // Each point's 0-based index in the mesh file's vertex order, written as
+    // the point field "file_vertex": for a volume when the numbering differs
+    // from the file's (mesh_options.compact removed vertices), for a surface
+    // always (its points are a subset).
     const index_t* file_vertex = nullptr;
 };
 
@@ -26,7 +40,8 @@ struct VtuFields {
 // given fields. The file is written whole or not at all (OutputFile): a
 // failed write leaves no partial file. Throws IoError naming the file when
 // it cannot be written.
-void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& fields = {});
+void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& fields = {},
+               VtuFormat format = VtuFormat::Binary);
 
 // A .pvd collection: add() frames as they are written, write() (also called
 // by the destructor, errors swallowed there) replaces the .pvd file in one

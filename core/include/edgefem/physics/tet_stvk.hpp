@@ -31,26 +31,46 @@ struct TetDeformation {
     T energy;
 };
 
+// H = Du Dm^-1 from the displacements U[i] of the tet's vertices and Dm^-1
+// (rows grad phi_1..3).
+template <class T>
+EDGEFEM_FORMULA void displacement_gradient(const T (&U)[4][3], const T (&Dinv)[3][3], T (&H)[3][3]) {
+    T D[3][3];  // column c: u(v_{c+1}) - u(v_0)
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) D[r][c] = U[c + 1][r] - U[0][r];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) H[r][c] = D[r][0] * Dinv[0][c] + D[r][1] * Dinv[1][c] + D[r][2] * Dinv[2][c];
+}
+
+// The Green strain G = (F^T F - I) / 2 = (H + H^T + H^T H) / 2 (symmetric).
+template <class S, class T>
+EDGEFEM_FORMULA void green_strain(const T (&H)[3][3], T (&G)[3][3]) {
+    for (int i = 0; i < 3; ++i)  // the upper triangle computed
+        for (int j = i; j < 3; ++j)
+            G[j][i] = G[i][j] = S(0.5) * (H[i][j] + H[j][i] + H[0][i] * H[0][j] + H[1][i] * H[1][j] + H[2][i] * H[2][j]);
+}
+
+// The StVK second Piola-Kirchhoff stress S = 2 mu G + lambda tr(G) I
+// (volume-scaled when lambda and mu are).
+template <class T>
+EDGEFEM_FORMULA void stvk_stress(const T (&G)[3][3], T lambda, T mu, T (&Sv)[3][3]) {
+    const T tr = G[0][0] + G[1][1] + G[2][2];
+    const T two_mu = 2 * mu, ltr = lambda * tr;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Sv[i][j] = two_mu * G[i][j] + (i == j ? ltr : T{});
+}
+
 // From the displacements U[i] of the tet's vertices and Dm^-1 (rows
 // grad phi_1..3), with vol_lambda = Vol lambda, vol_mu = Vol mu.
 template <bool Energy, class S, class T>
 EDGEFEM_FORMULA void tet_deformation(const T (&U)[4][3], const T (&Dinv)[3][3], T vol_lambda, T vol_mu,
                                      TetDeformation<T>& d) {
-    T D[3][3];  // column c: u(v_{c+1}) - u(v_0)
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) D[r][c] = U[c + 1][r] - U[0][r];
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) d.H[r][c] = D[r][0] * Dinv[0][c] + D[r][1] * Dinv[1][c] + D[r][2] * Dinv[2][c];
-    const auto& H = d.H;
-    T G[3][3];  // symmetric: the upper triangle computed
-    for (int i = 0; i < 3; ++i)
-        for (int j = i; j < 3; ++j)
-            G[j][i] = G[i][j] = S(0.5) * (H[i][j] + H[j][i] + H[0][i] * H[0][j] + H[1][i] * H[1][j] + H[2][i] * H[2][j]);
-    const T tr = G[0][0] + G[1][1] + G[2][2];
-    const T two_mu = 2 * vol_mu, ltr = vol_lambda * tr;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) d.Sv[i][j] = two_mu * G[i][j] + (i == j ? ltr : T{});
+    displacement_gradient(U, Dinv, d.H);
+    T G[3][3];
+    green_strain<S>(d.H, G);
+    stvk_stress(G, vol_lambda, vol_mu, d.Sv);
     if constexpr (Energy) {
+        const T tr = G[0][0] + G[1][1] + G[2][2];
         const T off = G[0][1] * G[0][1] + G[0][2] * G[0][2] + G[1][2] * G[1][2];
         const T GG = G[0][0] * G[0][0] + G[1][1] * G[1][1] + G[2][2] * G[2][2] + 2 * off;
         d.energy = S(0.5) * vol_lambda * tr * tr + vol_mu * GG;
