@@ -77,6 +77,13 @@ TEST(SceneJson, Defaults) {
     EXPECT_EQ(sf.output.dir, "edgefem-out");
     EXPECT_EQ(sf.output.every, 10);
     EXPECT_TRUE(sf.output.vtu);
+    // The documented output defaults: compressed binary VTU of the volume
+    // with displacement, velocity, force, energy density and von Mises.
+    EXPECT_EQ(sf.output.format, OutputFormat::Binary);
+    EXPECT_EQ(sf.output.mesh, OutputMesh::Volume);
+    const OutputFields f = sf.output.fields;
+    EXPECT_TRUE(f.displacement && f.velocity && f.force && f.energy_density && f.von_mises);
+    EXPECT_FALSE(f.green_strain || f.pk2_stress);
     EXPECT_EQ(sf.path, "scene.json");
 }
 
@@ -104,7 +111,8 @@ TEST(SceneJson, EveryKey) {
                    "definite_stiffness": true, "newton_tolerance": 1e-9, "newton_max_iterations": 12,
                    "load_steps": 3, "max_step_halvings": 2, "stiffness_interval": 1,
                    "fail_on_unconverged": false, "max_energy_growth": 3},
-        "output": {"dir": "out/here", "every": 4, "vtu": false}
+        "output": {"dir": "out/here", "every": 4, "vtu": false, "format": "obj", "mesh": "surface",
+                   "fields": ["green_strain", "pk2_stress"]}
     })",
                                dir.path());
     const Scene& s = sf.scene;
@@ -146,6 +154,11 @@ TEST(SceneJson, EveryKey) {
     EXPECT_EQ(sf.output.dir, "out/here");
     EXPECT_EQ(sf.output.every, 4);
     EXPECT_FALSE(sf.output.vtu);
+    EXPECT_EQ(sf.output.format, OutputFormat::Obj);
+    EXPECT_EQ(sf.output.mesh, OutputMesh::Surface);
+    const OutputFields f = sf.output.fields;
+    EXPECT_TRUE(f.green_strain && f.pk2_stress);
+    EXPECT_FALSE(f.displacement || f.velocity || f.force || f.energy_density || f.von_mises);
 }
 
 TEST(SceneJson, OtherSpellings) {
@@ -349,6 +362,14 @@ TEST(SceneJsonErrors, WrongTypes) {
     expect_error(scene(R"("output": {"every": 0})"), {"\"output.every\""});
     expect_error(scene(R"("output": {"dir": ""})"), {"\"output.dir\""});
     expect_error(scene(R"("output": {"vtu": "yes"})"), {"\"output.vtu\""});
+    expect_error(scene(R"("output": {"format": "vtk"})"), {"\"output.format\"", "\"binary\", \"ascii\"", "'vtk'"});
+    expect_error(scene(R"("output": {"format": 1})"), {"\"output.format\"", "got 1"});
+    expect_error(scene(R"("output": {"format": "ply"})"), {"\"output.format\"", "\"output.mesh\": \"surface\""});
+    expect_error(scene(R"("output": {"mesh": "skin"})"), {"\"output.mesh\"", "\"volume\", \"surface\""});
+    expect_error(scene(R"("output": {"fields": ["displacement", "stress"]})"),
+                 {"\"output.fields[1]\"", "unknown field \"stress\"", "pk2_stress"});
+    expect_error(scene(R"("output": {"fields": ["force", "force"]})"), {"\"output.fields[1]\"", "twice"});
+    expect_error(scene(R"("output": {"fields": "force"})"), {"\"output.fields\"", "array"});
     expect_error(scene(R"("material": {"poisson": 0.5})"), {"\"material.poisson\"", "(-1, 0.5)"});
     expect_error(scene(R"("material": {"young": 0})"), {"\"material.young\""});
     expect_error(scene(R"("material": {"density": -1})"), {"\"material.density\""});

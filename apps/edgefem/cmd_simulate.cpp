@@ -13,6 +13,7 @@
 #include "common.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/write_vtu.hpp"
+#include "frame_writer.hpp"
 #include "edgefem/partition/ordered_simulator.hpp"
 #include "output_paths.hpp"
 #include "sim_common.hpp"
@@ -30,6 +31,8 @@ struct SimulateOptions {
     std::string checkpoint;      // written every checkpoint_every steps and at the end
     long checkpoint_every = 0;   // 0: only at the end
     std::string restart;         // a checkpoint to resume from
+    std::string format;          // non-empty overrides output.format
+    bool quiet = false;          // no progress on stderr
     // Its ordering is the internal vertex numbering: RCM by default (the
     // force on bunny-1m runs 2-2.5x faster than in TetGen's numbering:
     // docs/layouts.md, "Orderings: bunny-1m force, 1 thread"); frames and
@@ -96,7 +99,9 @@ void run_simulate(const SimulateOptions& opts) {
     }
     if (!opts.preconditioner.empty())
         sf.scene.solver.preconditioner = parse_preconditioner(opts.preconditioner, "--preconditioner");
+    if (!opts.format.empty()) sf.output.format = parse_output_format(opts.format, sf.output.mesh, "--format");
     const OutputSettings out = sf.output;
+    const bool vtu = out.format == OutputFormat::Binary || out.format == OutputFormat::Ascii;  // PLY, OBJ: no .pvd
     const std::string name = sf.path.empty() ? "default" : std::filesystem::path(sf.path).stem().string();
 
     const auto executor = make_run_executor(opts.run);
@@ -119,20 +124,22 @@ void run_simulate(const SimulateOptions& opts) {
     std::optional<PvdSeries> series;
     if (out.vtu) {
         make_output_dir(out.dir, opts.out.empty() ? "output.dir" : "--out");
-        frames.emplace(scene, sf.file_vertex);
+        frames.emplace(scene, out, sf.file_vertex);
         const std::string pvd = (std::filesystem::path(out.dir) / (name + ".pvd")).string();
-        check_replaceable(pvd, kPvdSignature);
-        series.emplace(pvd);
-        // A restart's series lists the frames of the run before it (those
-        // of its output steps that are in the folder), at the times that
-        // run had (its time is summed step by step, as here).
-        double t = 0;
-        for (long s = 0; s <= first_step && first_step > 0; t += scene.dt, ++s) {
-            if (s % out.every != 0 && s != first_step) continue;
-            char frame[64];
-            std::snprintf(frame, sizeof frame, "_%06ld.vtu", s);
-            const std::string path = (std::filesystem::path(out.dir) / (name + frame)).string();
-            if (std::filesystem::is_regular_file(path)) series->add(t, path);
+        if (vtu) {
+            check_replaceable(pvd, kPvdSignature);
+            series.emplace(pvd);
+            // A restart's series lists the frames of the run before it (those
+            // of its output steps that are in the folder), at the times that
+            // run had (its time is summed step by step, as here).
+            double t = 0;
+            for (long s = 0; s <= first_step && first_step > 0; t += scene.dt, ++s) {
+                if (s % out.every != 0 && s != first_step) continue;
+                char frame[64];
+                std::snprintf(frame, sizeof frame, "_%06ld.vtu", s);
+                const std::string path = (std::filesystem::path(out.dir) / (name + frame)).string();
+                if (std::filesystem::is_regular_file(path)) series->add(t, path);
+            }
         }
         // Compaction renumbered the vertices: the map back to the file's numbering.
         if (!sf.file_vertex.empty()) {
@@ -142,15 +149,18 @@ void run_simulate(const SimulateOptions& opts) {
         }
     }
     char frame_name[64];
-    std::vector<double> u_user(3 * std::size_t(scene.mesh.num_vertices())), f_user(u_user.size());
+    std::vector<double> u_user(3 * std::size_t(scene.mesh.num_vertices())), v_user(u_user.size()),
+        f_user(u_user.size());
     const auto write_frame = [&] {
         if (!frames) return;
-        std::snprintf(frame_name, sizeof frame_name, "_%06ld.vtu", sim.step_index());
+        std::snprintf(frame_name, sizeof frame_name, "_%06ld%s", sim.step_index(), frames->extension());
         const std::string path = (std::filesystem::path(out.dir) / (name + frame_name)).string();
         osim.get_displacement(u_user);
+        osim.get_velocity(v_user);
         osim.get_forces(f_user);
-        check_replaceable(path, kVtuSignature);
-        frames->write(path, u_user, f_user);
+        check_replaceable(path, frame_signature(out.format));
+        frames->write(path, u_user, v_user, f_user);
+        if (!series) return;
         series->add(sim.time(), path);
         series->write();  // a crash later still leaves a usable series
     };
@@ -172,7 +182,7 @@ void run_simulate(const SimulateOptions& opts) {
     index_t inverted_max = 0;
     long inverted_steps = 0, first_inverted_step = 0;
     long unconverged_steps = 0;  // CG stopped above its tolerance
-    Progress progress(steps);
+    Progress progress(opts.quiet ? 0 : steps);
     if (first_step == 0) write_frame();  // a restart's was written by the run before it
     try {
         for (long s = 1; s <= steps; ++s) {
@@ -231,7 +241,9 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("unconverged_steps", unconverged_steps);
     print_kv("energy_drift", fmt(e_drift, 6));
     print_kv("inverted_tets", inverted_max);
-    if (out.vtu) print_kv("output", (std::filesystem::path(out.dir) / (name + ".pvd")).string());
+    if (out.vtu)
+        print_kv("output", (std::filesystem::path(out.dir) / (vtu ? name + ".pvd" : name + "_*" + file_extension(out.format)))
+                               .string());
     if (executor) print_adaptive(*executor);
     print_kv("wall_s", fmt(std::chrono::duration<double>(clock::now() - t_start).count(), 6));
 }
@@ -244,7 +256,8 @@ void add_simulate_command(CLI::App& app) {
         "simulate",
         "Step a scene (docs/scenes.md; without SCENE the built-in beam: 19,200 tets, clamped at one end, "
         "sagging under gravity, 1000 semi-implicit steps of 1 ms). Writes OUT/<scene>_<step>.vtu frames "
-        "(displacement, internal force, energy density) every output.every steps and OUT/<scene>.pvd; "
+        "(by default compressed binary: displacement, velocity, internal force, energy density, von Mises "
+        "stress; output.* in docs/scenes.md) every output.every steps and OUT/<scene>.pvd; "
         "shows progress on stderr; prints median timings per step, CG iterations, the energy drift "
         "(last - first total energy, relative to the largest kinetic + elastic energy seen) and the "
         "most inverted tets in any step");
@@ -273,6 +286,10 @@ void add_simulate_command(CLI::App& app) {
                     "Resume from a checkpoint of this scene (same integrator, solver and --ordering): steps on "
                     "from its step to the scene's last, bitwise as if the run had not stopped")
         ->check(CLI::ExistingFile);
+    cmd->add_option("--format", opts->format,
+                    "Frame format: binary (compressed VTU), ascii (VTU), ply or obj (with output.mesh \"surface\"); "
+                    "overrides the scene's output.format (docs/scenes.md)");
+    cmd->add_flag("--quiet", opts->quiet, "No progress on stderr");
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->run.ordering);
     add_run_options(*cmd, opts->run);

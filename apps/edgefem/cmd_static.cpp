@@ -1,5 +1,7 @@
 // `edgefem static SCENE.json --out PREFIX`: static equilibrium of a scene
 // under its gravity and prescribed targets.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -7,7 +9,7 @@
 
 #include "common.hpp"
 #include "edgefem/core/simulator.hpp"
-#include "edgefem/core/write_vtu.hpp"
+#include "frame_writer.hpp"
 #include "edgefem/partition/ordered_simulator.hpp"
 #include "output_paths.hpp"
 #include "sim_common.hpp"
@@ -18,7 +20,33 @@ namespace {
 
 struct StaticOptions {
     std::string scene, out;
+    std::string format;  // non-empty overrides output.format (binary or ascii)
+    bool quiet = false;  // no progress on stderr
     RunOptions run;  // its ordering: the internal numbering
+};
+
+// Newton's progress on stderr: one line redrawn in place on a terminal,
+// else a line per iteration.
+class StaticProgressLine {
+public:
+    StaticProgressLine() : tty_(::isatty(::fileno(stderr)) == 1) {}
+    ~StaticProgressLine() { finish(); }
+
+    void update(const StaticProgress& p) {
+        std::fprintf(stderr, "%sedgefem: load step %d (load %.4g%%): Newton iterations %d, relative residual %.3e%s",
+                     tty_ ? "\r" : "", p.load_step, 100 * p.load_fraction, p.newton_iterations, p.residual,
+                     tty_ ? "  " : "\n");
+        open_ = tty_;
+    }
+    // Ends the line (before the summary or an error message).
+    void finish() {
+        if (open_) std::fputc('\n', stderr);
+        open_ = false;
+    }
+
+private:
+    bool tty_;
+    bool open_ = false;
 };
 
 void run_static(const StaticOptions& opts) {
@@ -30,18 +58,31 @@ void run_static(const StaticOptions& opts) {
     check_replaceable(opts.out + ".disp", "");
     check_replaceable(opts.out + ".vtu", kVtuSignature);
     SceneFile sf = load_scene_file(opts.scene);
+    // The volume as VTU: the scene's output.fields, output.format when it is
+    // binary or ascii (a surface's PLY or OBJ is simulate's).
+    OutputSettings output = sf.output;
+    output.mesh = OutputMesh::Volume;
+    if (!opts.format.empty()) output.format = parse_output_format(opts.format, OutputMesh::Volume, "--format");
+    if (output.format != OutputFormat::Ascii) output.format = OutputFormat::Binary;
     if (!sf.file_vertex.empty()) check_replaceable(opts.out + ".vertex-map", kVertexMapSignature);
     const auto executor = make_run_executor(opts.run);
     OrderedSimulator<double> osim(sf.scene, parse_ordering(opts.run.ordering),
                                   make_run_backend<double>(opts.run, executor));
     const Simulator<double>& sim = osim.internal();
-    const StaticResult r = osim.solve_static();
+    StaticProgressLine line;
+    StaticResult r;
+    if (opts.quiet) {
+        r = osim.solve_static();
+    } else {
+        r = osim.solve_static([&](const StaticProgress& p) { line.update(p); });
+        line.finish();
+    }
 
     std::vector<double> u(3 * std::size_t(sf.scene.mesh.num_vertices())), f(u.size());
     osim.get_displacement(u);
     osim.get_forces(f);
     write_vectors(opts.out + ".disp", u);
-    FrameWriter(sf.scene, sf.file_vertex).write(opts.out + ".vtu", u, f);
+    FrameWriter(sf.scene, output, sf.file_vertex).write(opts.out + ".vtu", u, {}, f);
     // Compaction renumbered the vertices: the .disp lines and .vtu points
     // follow the scene's numbering; the map leads back to the file's.
     if (!sf.file_vertex.empty()) write_vertex_map(opts.out + ".vertex-map", sf.file_vertex);
@@ -78,11 +119,14 @@ void add_static_command(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "static",
         "Static equilibrium of a scene (docs/scenes.md) under gravity and its prescribed targets, by Newton "
-        "with line search and automatic load stepping; writes PREFIX.disp (one 'ux uy uz' line per vertex, "
+        "with line search and automatic load stepping, showing its progress on stderr; writes PREFIX.disp (one 'ux uy uz' line per vertex, "
         "%.17g) and PREFIX.vtu");
     // An empty SCENE would mean the built-in beam (load_scene_file).
     cmd->add_option("SCENE", opts->scene, "Scene file (JSON, see docs/scenes.md)")->required()->check(non_empty_path());
     cmd->add_option("--out", opts->out, "Output file prefix")->required()->check(non_empty_path());
+    cmd->add_option("--format", opts->format,
+                    "PREFIX.vtu as binary (compressed, the default) or ascii; overrides the scene's output.format");
+    cmd->add_flag("--quiet", opts->quiet, "No progress (load steps, Newton iterations, residuals) on stderr");
     cmd->footer(kExitCodesHelp);
     add_ordering_option(*cmd, opts->run.ordering);
     add_run_options(*cmd, opts->run);

@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "edgefem/core/scene_json.hpp"
+
 namespace edgefem::cli {
 
 // A scene's output.dir: throws InvalidArgument naming the scene when it is
@@ -30,5 +32,13 @@ inline constexpr std::string_view kPvdSignature = "<?xml version=\"1.0\"?>\n<VTK
 inline constexpr std::string_view kVertexMapSignature = "# edgefem vertex map";
 // And the checkpoints' magic (edgefem/core/checkpoint.hpp).
 inline constexpr std::string_view kCheckpointSignature = "EFEMCKPT";
+// ... and what write_ply and write_obj write.
+inline constexpr std::string_view kPlySignature = "ply\nformat binary_little_endian 1.0\ncomment edgefem surface\n";
+inline constexpr std::string_view kObjSignature = "# edgefem surface";
+
+// The signature of a frame in `format`.
+inline std::string_view frame_signature(OutputFormat format) {
+    return format == OutputFormat::Ply ? kPlySignature : format == OutputFormat::Obj ? kObjSignature : kVtuSignature;
+}
 
 }  // namespace edgefem::cli

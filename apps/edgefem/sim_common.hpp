@@ -3,37 +3,18 @@
 // lives in core (Simulator, the kernels).
 #pragma once
 
-#include <optional>
-#include <span>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "edgefem/core/scene_json.hpp"
-#include "edgefem/core/tet_model.hpp"
 
 namespace edgefem::cli {
 
 // load_scene(path), or the built-in default_scene_file() when `path` is
 // empty; prints the scene's warnings to stderr.
 SceneFile load_scene_file(const std::string& path);
-
-// Writes .vtu frames: displacement, internal forces and (for the FE model)
-// the strain energy density of every tet.
-class FrameWriter {
-public:
-    // `file_vertex` (SceneFile::file_vertex): when not empty, every frame
-    // carries it as the point field "file_vertex".
-    explicit FrameWriter(const Scene& scene, std::vector<index_t> file_vertex = {});
-    void write(const std::string& path, std::span<const double> u, std::span<const double> f);
-
-private:
-    const Mesh& mesh_;
-    std::vector<index_t> file_vertex_;
-    std::optional<TetModel<double>> tets_;  // FE only: the SN energy is not per tet
-    std::vector<double> density_;
-};
 
 // Writes SceneFile::file_vertex to `path`: a "# edgefem vertex map" line,
 // then one line per output vertex with its 0-based index in the mesh file.

@@ -471,12 +471,59 @@ void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     }
 }
 
+constexpr std::pair<const char*, OutputFormat> kOutputFormats[] = {
+    {"binary", OutputFormat::Binary}, {"ascii", OutputFormat::Ascii}, {"ply", OutputFormat::Ply}, {"obj", OutputFormat::Obj}};
+
+// Empty when `name` is a format that suits `mesh` (then in `out`), else why not.
+std::string output_format_error(const std::string& name, OutputMesh mesh, OutputFormat& out) {
+    for (const auto& [n, f] : kOutputFormats) {
+        if (name != n) continue;
+        if ((f == OutputFormat::Ply || f == OutputFormat::Obj) && mesh != OutputMesh::Surface)
+            return "\"" + name + "\" holds triangles only: it needs \"output.mesh\": \"surface\"";
+        out = f;
+        return {};
+    }
+    return "expected one of \"binary\", \"ascii\", \"ply\", \"obj\", got '" + printable(name) + "'";
+}
+
+OutputFields read_output_fields(const Context& cx, const json& v, const std::string& path) {
+    if (!v.is_array()) cx.fail(path, "expected an array of field names, got " + show(v));
+    OutputFields f{false, false, false, false, false, false, false};
+    const std::pair<const char*, bool OutputFields::*> names[] = {
+        {"displacement", &OutputFields::displacement}, {"velocity", &OutputFields::velocity},
+        {"force", &OutputFields::force},               {"energy_density", &OutputFields::energy_density},
+        {"green_strain", &OutputFields::green_strain}, {"pk2_stress", &OutputFields::pk2_stress},
+        {"von_mises", &OutputFields::von_mises}};
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        const auto it = std::find_if(std::begin(names), std::end(names), [&](const auto& n) {
+            return v[i].is_string() && v[i].get<std::string>() == n.first;
+        });
+        if (it == std::end(names)) {
+            std::string list;
+            for (const auto& n : names) list += (list.empty() ? "" : ", ") + std::string(n.first);
+            cx.fail(item(path, i), "unknown field " + show(v[i]) + " (expected one of: " + list + ")");
+        }
+        if (f.*(it->second)) cx.fail(item(path, i), "field " + show(v[i]) + " listed twice");
+        f.*(it->second) = true;
+    }
+    return f;
+}
+
 void read_output(const Context& cx, const json& v, OutputSettings& o) {
     const std::string p = "output";
-    check_keys(cx, v, p, {"dir", "every", "vtu"});
+    check_keys(cx, v, p, {"dir", "every", "vtu", "format", "mesh", "fields"});
     if (const json* x = find(v, "dir")) o.dir = get_string(cx, *x, join(p, "dir"));  // relative to the current directory
     if (const json* x = find(v, "every")) o.every = get_int(cx, *x, join(p, "every"), 1);
     if (const json* x = find(v, "vtu")) o.vtu = get_bool(cx, *x, join(p, "vtu"));
+    if (const json* x = find(v, "mesh"))
+        o.mesh = get_enum<OutputMesh>(cx, *x, join(p, "mesh"), {{"volume", OutputMesh::Volume}, {"surface", OutputMesh::Surface}});
+    if (const json* x = find(v, "format")) {
+        const std::string key = join(p, "format");
+        if (!x->is_string()) cx.fail(key, "expected one of \"binary\", \"ascii\", \"ply\", \"obj\", got " + show(*x));
+        if (const std::string error = output_format_error(x->get<std::string>(), o.mesh, o.format); !error.empty())
+            cx.fail(key, error);
+    }
+    if (const json* x = find(v, "fields")) o.fields = read_output_fields(cx, *x, join(p, "fields"));
 }
 
 // [[t, value], ...] with strictly increasing times.
@@ -910,6 +957,23 @@ SceneFile default_scene_file() {
     sf.scene = default_scene();
     sf.output.every = 20;
     return sf;
+}
+
+const char* to_string(OutputFormat format) {
+    for (const auto& [name, f] : kOutputFormats)
+        if (f == format) return name;
+    return "";
+}
+
+const char* file_extension(OutputFormat format) {
+    return format == OutputFormat::Ply ? ".ply" : format == OutputFormat::Obj ? ".obj" : ".vtu";
+}
+
+OutputFormat parse_output_format(const std::string& name, OutputMesh mesh, const std::string& what) {
+    OutputFormat f{};
+    if (const std::string error = output_format_error(name, mesh, f); !error.empty())
+        throw InvalidArgument(printable(what) + ": " + error);
+    return f;
 }
 
 }  // namespace edgefem

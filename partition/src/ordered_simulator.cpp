@@ -140,11 +140,11 @@ const StepStats& OrderedSimulator<S>::step() {
 }
 
 template <class S>
-StaticResult OrderedSimulator<S>::solve_static() {
+StaticResult OrderedSimulator<S>::solve_static(const StaticProgressFn& progress) {
     const InUseFlag::Claim claim(in_use_, "solve_static");
     push();
     try {
-        const StaticResult r = sim_.solve_static();
+        const StaticResult r = sim_.solve_static(progress);
         pull();
         return r;
     } catch (const SimulationError& e) {

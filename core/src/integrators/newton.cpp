@@ -94,6 +94,7 @@ void Newton<S>::solve(const Inertia* scheme, const ElasticOperator<S>* K0) {
         stats.residual = scale > 0 ? rn / scale : rn;
         if (!std::isfinite(rn))
             throw StepFailure{"step " + std::to_string(s_.step + 1) + ": non-finite residual in Newton", -1};
+        if (s_.newton_observer) s_.newton_observer(stats.residual);
         if (rn <= tolerance * scale || rn <= underflow) return;
         stalled = stats.residual > 0.5 * best ? stalled + 1 : 0;
         best = std::min(best, stats.residual);

@@ -7,7 +7,7 @@
 namespace edgefem::sim {
 
 template <class S>
-StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
+StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve, const StaticProgressFn& progress) {
     s.kernels.fill_state(s.v.data(), s.n(), S(0));
     if (s.con_vertex.empty())
         throw InvalidArgument("static equilibrium needs fixed or prescribed vertices (else it is singular)");
@@ -22,8 +22,22 @@ StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
     double done = 0, inc = 1.0 / s.scene.solver.load_steps;
     int halvings = 0;
     BackendVector<S> u_save = s.template vector<S>(0);
+    StaticProgress now;
+    // Newton reports its residuals through the state while this solve runs.
+    struct Observer {
+        SimState<S>& s;
+        ~Observer() { s.newton_observer = nullptr; }
+    } observer{s};
+    if (progress)
+        s.newton_observer = [&](double residual) {
+            now.newton_iterations = s.stats.newton_iterations;
+            now.residual = residual;
+            progress(now);
+        };
     while (done < 1 - 1e-15) {
         const double load = std::min(1.0, done + inc);
+        ++now.load_step;
+        now.load_fraction = load;
         s.copy_state(u_save, s.u);
         s.external(load);
         s.hold_constraints(load);
@@ -54,7 +68,7 @@ StaticResult solve_static(SimState<S>& s, TangentSolve<S>& solve) {
     return result;
 }
 
-template StaticResult solve_static(SimState<double>&, TangentSolve<double>&);
-template StaticResult solve_static(SimState<float>&, TangentSolve<float>&);
+template StaticResult solve_static(SimState<double>&, TangentSolve<double>&, const StaticProgressFn&);
+template StaticResult solve_static(SimState<float>&, TangentSolve<float>&, const StaticProgressFn&);
 
 }  // namespace edgefem::sim

@@ -9,6 +9,6 @@
 namespace edgefem::sim {
 
 template <class S>
-StaticResult solve_static(SimState<S>& state, TangentSolve<S>& solve);
+StaticResult solve_static(SimState<S>& state, TangentSolve<S>& solve, const StaticProgressFn& progress = {});
 
 }  // namespace edgefem::sim

@@ -171,10 +171,10 @@ const StepStats& Simulator<S>::step() {
     return m.on_state("step", [&]() -> const StepStats& { return m.control.step(); });
 }
 template <class S>
-StaticResult Simulator<S>::solve_static() {
+StaticResult Simulator<S>::solve_static(const StaticProgressFn& progress) {
     Impl& m = self();
     try {
-        return m.on_state("solve_static", [&] { return sim::solve_static(m.state, m.solve); });
+        return m.on_state("solve_static", [&] { return sim::solve_static(m.state, m.solve, progress); });
     } catch (const sim::StepFailure& failure) {
         throw SimulationError("static solve: " + failure.message, self().state.step, failure.vertex);
     }

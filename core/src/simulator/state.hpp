@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,6 +65,9 @@ struct SimState {
     History<S> history;           // the integrator's (integrators/time_integrator.hpp)
     BackendVector<S> damping_u;   // the u of the last damping tangent K0 (build_damping_tangent)
     StepStats stats;
+    // Called with the relative residual at every Newton iteration when set
+    // (solve_static's progress).
+    std::function<void(double)> newton_observer;
     long step = 0;
     double time = 0;
 

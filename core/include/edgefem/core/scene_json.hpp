@@ -10,13 +10,38 @@
 
 namespace edgefem {
 
+// Which fields the frames carry (docs/scenes.md, "Output of edgefem
+// simulate"); the strain and stress fields need the FE model.
+struct OutputFields {
+    bool displacement = true, velocity = true, force = true;            // point
+    bool energy_density = true, green_strain = false, pk2_stress = false, von_mises = true;  // cell
+};
+
+// What a frame holds: the tet mesh or its boundary surface.
+enum class OutputMesh { Volume, Surface };
+// The frames' file format: VTU (compressed binary or ASCII), PLY (binary
+// little endian) or OBJ; PLY and OBJ only for the surface.
+enum class OutputFormat { Binary, Ascii, Ply, Obj };
+
 // Where and how often a simulation writes frames; not part of the Scene
 // (the library never writes files by itself).
 struct OutputSettings {
     std::string dir = "edgefem-out";  // relative to the current directory
     int every = 10;                   // write a frame every this many steps
-    bool vtu = true;                  // write .vtu frames and a .pvd series
+    bool vtu = true;                  // write frames (and, for VTU, a .pvd series)
+    OutputFormat format = OutputFormat::Binary;
+    OutputMesh mesh = OutputMesh::Volume;
+    OutputFields fields;
 };
+
+// The names of output.format's values ("binary", "ascii", "ply", "obj") and
+// the frames' file extension (".vtu", ".ply", ".obj").
+const char* to_string(OutputFormat format);
+const char* file_extension(OutputFormat format);
+// The OutputFormat called `name`; InvalidArgument naming `what` and the
+// valid names otherwise. Also checks that PLY and OBJ go with a surface
+// (naming `what` again).
+OutputFormat parse_output_format(const std::string& name, OutputMesh mesh, const std::string& what);
 
 struct SceneFile {
     Scene scene;                        // validated

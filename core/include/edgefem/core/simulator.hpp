@@ -3,6 +3,7 @@
 // and advances it with the scene's integrator.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -61,6 +62,16 @@ struct StaticResult {
     bool converged = false;
 };
 
+// What solve_static reports at every Newton iteration (including each load
+// step's first residual, before an iteration).
+struct StaticProgress {
+    int load_step = 0;           // the load step being solved, from 1 (a retried, halved step counts again)
+    double load_fraction = 0;    // the fraction of the full load it reaches
+    int newton_iterations = 0;   // over the whole solve so far
+    double residual = 0;         // the relative residual now
+};
+using StaticProgressFn = std::function<void(const StaticProgress&)>;
+
 template <class S>
 class Simulator {
 public:
@@ -94,8 +105,9 @@ public:
     // Static equilibrium under gravity, external forces and the prescribed
     // targets (reached fully), by Newton with line search and automatic load
     // stepping; the result becomes the state (velocity zero), and later
-    // steps hold the prescribed vertices at their targets.
-    StaticResult solve_static();
+    // steps hold the prescribed vertices at their targets. `progress`, when
+    // set, is called at every Newton iteration.
+    StaticResult solve_static(const StaticProgressFn& progress = {});
 
     // Views (3 #V, xyz per vertex) of the back-end's vectors: zero-copy in
     // host memory; for a GPU back-end a host copy made when first asked for

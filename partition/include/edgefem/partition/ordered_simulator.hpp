@@ -36,7 +36,7 @@ public:
     // A SimulationError names its vertex in the user's numbering (vertex()
     // and the message's "vertex N").
     const StepStats& step();
-    StaticResult solve_static();
+    StaticResult solve_static(const StaticProgressFn& progress = {});
     Energies energies();
     double time() const { return sim_.time(); }
     long step_index() const { return sim_.step_index(); }
