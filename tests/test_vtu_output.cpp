@@ -334,7 +334,9 @@ TEST(SurfaceFiles, PlyReadsBackWithOutwardTriangles) {
         if (a == "element" && b == "vertex") nv = std::stoul(c);
         if (a == "element" && b == "face") nf = std::stoul(c);
         if (a == "property" && b == "float") props.push_back(c);
-        if (a == "property" && b == "list") EXPECT_EQ(line, "property list uchar int vertex_indices");
+        if (a == "property" && b == "list") {
+            EXPECT_EQ(line, "property list uchar int vertex_indices");
+        }
     }
     EXPECT_EQ(format, "binary_little_endian");
     EXPECT_EQ(props, (std::vector<std::string>{"x", "y", "z", "nx", "ny", "nz"}));
