@@ -9,7 +9,10 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <locale>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "edgefem/core/error.hpp"
 #include "test_meshes.hpp"
@@ -21,6 +24,16 @@ inline std::string data_file(const std::string& name) { return test_data_dir() +
 inline std::string slurp(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The whitespace-separated numbers of a text (e.g. an ASCII DataArray).
+inline std::vector<double> numbers(const std::string& text) {
+    std::istringstream in(text);
+    in.imbue(std::locale::classic());
+    std::vector<double> out;
+    double x;
+    while (in >> x) out.push_back(x);
+    return out;
 }
 
 inline void spit(const std::string& path, const std::string& text) {

@@ -28,6 +28,7 @@
 #include "io_test_util.hpp"
 
 using namespace edgefem;
+using edgefem::test::numbers;
 using edgefem::test::slurp;
 
 namespace {
@@ -102,15 +103,6 @@ std::vector<T> values(const Array& a) {
     std::vector<T> v(a.bytes.size() / sizeof(T));
     std::memcpy(v.data(), a.bytes.data(), v.size() * sizeof(T));
     return v;
-}
-
-std::vector<double> numbers(const std::string& text) {
-    std::istringstream in(text);
-    in.imbue(std::locale::classic());
-    std::vector<double> out;
-    double x;
-    while (in >> x) out.push_back(x);
-    return out;
 }
 
 // Bitwise: the same doubles, -0 and NaN payloads included.

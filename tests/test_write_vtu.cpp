@@ -19,6 +19,7 @@
 #include "io_test_util.hpp"
 
 using namespace edgefem;
+using edgefem::test::numbers;
 using edgefem::test::slurp;
 
 namespace {
@@ -40,15 +41,6 @@ std::string array_text(const std::string& xml, const std::string& attribute,
         }
         at = close;
     }
-}
-
-std::vector<double> numbers(const std::string& text) {
-    std::istringstream in(text);
-    in.imbue(std::locale::classic());
-    std::vector<double> out;
-    double x;
-    while (in >> x) out.push_back(x);
-    return out;
 }
 
 bool contains(const std::string& s, const std::string& part) {
