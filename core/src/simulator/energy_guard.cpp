@@ -21,26 +21,7 @@ EnergySample EnergyGuard<S>::start() {
     const bool same = evaluated_valid_ && s_.kernels.count_differences(s_.u.data(), u_evaluated_.data(), s_.n()) == 0;
     const double W = same ? W_evaluated_ : s_.forces(true);
     s_.forces_current = true;
-    if (s_.scene.rayleigh_alpha > 0) {
-        u_start_.resize(s_.n());
-        s_.kernels.from_state(u_start_.data(), s_.u.data(), s_.n());
-    }
     return sample(W);
-}
-
-template <class S>
-double EnergyGuard<S>::mass_damping_work(double T) {
-    const double alpha = s_.scene.rayleigh_alpha;
-    if (!(alpha > 0)) return 0;
-    const std::size_t n = s_.n();
-    du_.resize(n);
-    du_state_.resize(n);
-    s_.kernels.newton_increment(du_.data(), s_.u.data(), u_start_.data(), n);
-    s_.kernels.to_state(du_state_.data(), du_.data(), n);
-    const S* d = du_state_.data();
-    // energy_sums' first sum is |d|_M^2 / 2 with d as the velocity.
-    const double half = s_.kernels.energy_sums(d, d, d, s_.mass.data(), {0, 0, 0}, n)[0];
-    return 2 * alpha * half / T;
 }
 
 template <class S>
@@ -50,19 +31,10 @@ bool EnergyGuard<S>::constraints_move(double t_end) const {
 }
 
 // The step's gain is its energy change net of the external work (f_ext is
-// constant over the step: f_ext.du) and of what mass damping removed, so it
-// is the integrator's own energy error: damping does not hide an injection.
-// The damping work is alpha |du|_M^2 / T: the force alpha M du / T over du,
-// which is exact for the schemes whose step is du = T v' with the damping
-// at v' (symplectic, semi-implicit and backward Euler: 2 T alpha x the new
-// kinetic energy) and for the trapezoidal rule (du = T (v + v') / 2, its
-// damping at that mean), and second-order close for the others. Until
-// 2026-11-27 it was 2 T alpha x the new kinetic energy for every scheme:
-// under the trapezoidal rule a mode the step does not resolve flips its
-// velocity every step (v' ~ -v) and is barely damped, so that credit
-// counted damping that never happened as a gain, which added up until the
-// guard failed healthy runs (the stress suite's bent bar, Newmark at 1 ms
-// with alpha = 10 /s: "+1 x" at step 817). Gains accumulate from their lowest
+// constant over the step: f_ext.du) and of what mass damping removed (every
+// integrator applies alpha M v with the new velocity over du = T v: 2 T
+// alpha x kinetic energy), so it is the integrator's own energy error:
+// damping does not hide an injection. Gains accumulate from their lowest
 // level (a one-sided CUSUM: dissipation is no credit for later injection)
 // and may not exceed (max_energy_growth - 1) x the largest kinetic +
 // elastic energy the body has had net of such gains, plus the sums'
@@ -83,7 +55,7 @@ void EnergyGuard<S>::check(double T, const EnergySample& start, double W_end, bo
     double scale = std::max(energy_scale_, start.kinetic + start.elastic - energy_excess_);
     double excess = energy_excess_;
     if (!constraints_moved) {
-        const double damping = mass_damping_work(T);
+        const double damping = 2 * T * scene.rayleigh_alpha * end.kinetic;
         const double gain = (end.total() - start.total()) - (end.load - start.load) + damping;
         const double noise = 256 * double(std::numeric_limits<S>::epsilon()) * (start.magnitude() + end.magnitude());
         excess += gain;

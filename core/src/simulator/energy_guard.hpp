@@ -25,9 +25,7 @@ struct EnergySample {
 template <class S>
 class EnergyGuard {
 public:
-    explicit EnergyGuard(SimState<S>& state)
-        : s_(state), u_evaluated_(state.template vector<S>(0)), u_start_(state.template vector<double>(0)),
-          du_(state.template vector<double>(0)), du_state_(state.template vector<S>(0)) {}
+    explicit EnergyGuard(SimState<S>& state) : s_(state), u_evaluated_(state.template vector<S>(0)) {}
     bool enabled() const { return s_.scene.solver.max_energy_growth > 0; }
 
     // The state at the start of a step. The elastic energy comes from the
@@ -64,15 +62,9 @@ public:
 
 private:
     EnergySample sample(double W) const;
-    // What mass damping removed over the step from u_start_ to u:
-    // alpha |u - u_start|_M^2 / T.
-    double mass_damping_work(double T);
 
     SimState<S>& s_;
     BackendVector<S> u_evaluated_;  // the u that f, the operator's state and W_evaluated_ belong to
-    BackendVector<double> u_start_;  // u at the step's start (rayleigh_alpha > 0)
-    BackendVector<double> du_;
-    BackendVector<S> du_state_;
     double W_evaluated_ = 0;
     bool evaluated_valid_ = false;
     double energy_excess_ = 0;  // energy gained net of work since its lowest level (>= 0)
