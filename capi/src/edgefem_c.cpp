@@ -5,14 +5,17 @@
 #include "edgefem/edgefem.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <exception>
 #include <memory>
 #include <mutex>
 #include <new>
+#include <span>
 #include <string>
 #include <unordered_set>
 #include <utility>
+#include <vector>
 
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
@@ -30,6 +33,11 @@
 
 struct edgefem_scene {
     edgefem::Scene scene;
+};
+
+struct edgefem_embedding {
+    edgefem::Mesh mesh;  // the scene's, copied: the scene may go first
+    edgefem::Embedding embedding;
 };
 
 struct edgefem_sim {
@@ -907,3 +915,82 @@ edgefem_status edgefem_sim_load_checkpoint(edgefem_sim* sim, const char* path) {
 }
 
 }  // extern "C"
+
+edgefem_status edgefem_embedding_create(const edgefem_scene* scene, const double* points, size_t count,
+                                        edgefem_embedding** out) {
+    if (out) *out = nullptr;
+    return guard("edgefem_embedding_create", [&] {
+        require(scene, "scene");
+        require(points, "points");
+        require(out, "out");
+        if (count == 0 || count % 3 != 0)
+            invalid("points: count is " + std::to_string(count) + ", expected 3 x (number of points) > 0");
+        require_finite(points, count, "points");
+        edgefem::Embedding e = edgefem::embed_points(scene->scene.mesh, std::span<const double>(points, count));
+        *out = new_handle<edgefem_embedding>(edgefem_embedding{scene->scene.mesh, std::move(e)});
+    });
+}
+
+void edgefem_embedding_destroy(edgefem_embedding* embedding) { destroy_handle(embedding); }
+
+edgefem_status edgefem_embedding_num_points(const edgefem_embedding* embedding, size_t* num_points) {
+    return guard("edgefem_embedding_num_points", [&] {
+        require(embedding, "embedding");
+        require(num_points, "num_points");
+        *num_points = embedding->embedding.tet.size();
+    });
+}
+
+edgefem_status edgefem_embedding_get_outside(const edgefem_embedding* embedding, double* out, size_t count) {
+    return guard("edgefem_embedding_get_outside", [&] {
+        require(embedding, "embedding");
+        require(out, "out");
+        const auto& d = embedding->embedding.outside;
+        if (count != d.size())
+            invalid("out: count is " + std::to_string(count) + ", expected the number of points " +
+                    std::to_string(d.size()));
+        std::copy(d.begin(), d.end(), out);
+    });
+}
+
+edgefem_status edgefem_sim_embedded_positions(const edgefem_sim* sim, const edgefem_embedding* embedding, double* out,
+                                              size_t count) {
+    return guard("edgefem_sim_embedded_positions", [&] {
+        require(sim, "sim");
+        require(embedding, "embedding");
+        require(out, "out");
+        const std::size_t points = embedding->embedding.tet.size();
+        if (std::size_t(embedding->mesh.num_vertices()) != std::size_t(sim->sim.num_vertices()))
+            invalid("embedding: made for a mesh of " + std::to_string(embedding->mesh.num_vertices()) +
+                    " vertices, the simulation has " + std::to_string(sim->sim.num_vertices()));
+        if (count != 3 * points)
+            invalid("out: count is " + std::to_string(count) + ", expected 3 x (number of points) = " +
+                    std::to_string(3 * points));
+        const auto u = mut(sim).displacement();
+        edgefem::embedded_positions<double>(embedding->mesh, embedding->embedding,
+                                            std::span<const double>(u.data(), u.size()), std::span<double>(out, count));
+    });
+}
+
+edgefem_status edgefem_vertex_normals(const int32_t* triangles, size_t num_triangles, const double* positions,
+                                      size_t num_vertices, double* normals) {
+    return guard("edgefem_vertex_normals", [&] {
+        require(triangles, "triangles");
+        require(positions, "positions");
+        require(normals, "normals");
+        std::vector<std::array<edgefem::index_t, 3>> tri(num_triangles);
+        for (size_t k = 0; k < num_triangles; ++k)
+            for (int i = 0; i < 3; ++i) {
+                const int32_t v = triangles[3 * k + size_t(i)];
+                if (v < 0 || size_t(v) >= num_vertices)
+                    invalid("triangles[" + std::to_string(3 * k + size_t(i)) + "] = " + std::to_string(v) +
+                            " (triangle " + std::to_string(k) + ") is not a vertex in [0, " +
+                            std::to_string(num_vertices) + ")");
+                tri[k][size_t(i)] = v;
+            }
+        require_finite(positions, 3 * num_vertices, "positions");
+        const std::vector<double> n =
+            edgefem::vertex_normals(tri, std::span<const double>(positions, 3 * num_vertices));
+        std::copy(n.begin(), n.end(), normals);
+    });
+}

@@ -202,6 +202,84 @@ static void test_surfaces_regions_loads(void) {
     edgefem_scene_destroy(bar);
 }
 
+/* Render surfaces: points embedded in the tets follow an affine motion
+ * u = A X exactly (barycentric interpolation reproduces affine fields, also
+ * extrapolated outside the mesh); vertex normals of two triangles; errors. */
+static void test_embedding(void) {
+    double* X;
+    int32_t* T;
+    int32_t nv, nt;
+    make_box(3, 2, 2, 0.1, &X, &nv, &T, &nt); /* [-0.15, 0.15] x [-0.1, 0.1] x [-0.1, 0.1] */
+    edgefem_scene* scene = NULL;
+    CHECK_OK(edgefem_scene_create_from_arrays(X, nv, T, nt, &scene));
+    const double pts[] = {0.01, 0.02, -0.03, -0.14, 0.09, 0.05, 0.1, -0.05, 0.099, 0.2, 0.0, 0.0 /* outside */};
+    const size_t np = 4;
+    edgefem_embedding* e = NULL;
+    CHECK_OK(edgefem_embedding_create(scene, pts, 3 * np, &e));
+    size_t n = 0;
+    CHECK_OK(edgefem_embedding_num_points(e, &n));
+    CHECK(n == np);
+    double outside[4];
+    CHECK_OK(edgefem_embedding_get_outside(e, outside, np));
+    /* the last point is 0.05 m beyond the face x = 0.15; the estimate is the
+     * distance to its tet's face plane, here a diagonal one (0.05 / sqrt 2) */
+    CHECK(outside[0] == 0 && outside[1] == 0 && outside[2] == 0 && outside[3] > 0.02 && outside[3] <= 0.05 + 1e-15);
+    edgefem_sim* sim = NULL;
+    CHECK_OK(edgefem_sim_create(scene, &sim));
+    edgefem_scene_destroy(scene); /* the embedding keeps its own mesh */
+    const double A[3][3] = {{0.1, -0.2, 0.05}, {0.3, 0.02, -0.1}, {-0.05, 0.15, 0.2}};
+    double* u = malloc(sizeof(double) * 3 * (size_t)nv);
+    for (int32_t v = 0; v < nv; ++v)
+        for (int i = 0; i < 3; ++i)
+            u[3 * v + i] = A[i][0] * X[3 * v] + A[i][1] * X[3 * v + 1] + A[i][2] * X[3 * v + 2];
+    CHECK_OK(edgefem_sim_set_displacement(sim, u, 3 * (size_t)nv));
+    double y[12];
+    CHECK_OK(edgefem_sim_embedded_positions(sim, e, y, 3 * np));
+    double worst = 0;
+    for (size_t k = 0; k < np; ++k)
+        for (int i = 0; i < 3; ++i) {
+            const double* p = pts + 3 * k;
+            const double want = p[i] + A[i][0] * p[0] + A[i][1] * p[1] + A[i][2] * p[2];
+            worst = fmax(worst, fabs(y[3 * k + i] - want));
+        }
+    CHECK(worst < 1e-15);
+    expect_error(edgefem_sim_embedded_positions(sim, e, y, 3 * np - 1), EDGEFEM_ERROR_INVALID_ARGUMENT,
+                 "3 x (number of points)", "short embedded positions buffer");
+    const double bad_pts[] = {0, 0, NAN};
+    edgefem_embedding* bad = NULL;
+    edgefem_scene* scene2 = NULL;
+    CHECK_OK(edgefem_scene_create_box(2, 2, 2, 0.1, &scene2));
+    expect_error(edgefem_embedding_create(scene2, bad_pts, 3, &bad), EDGEFEM_ERROR_INVALID_ARGUMENT, "points[2]",
+                 "NaN render point");
+    CHECK(bad == NULL);
+    expect_error(edgefem_embedding_create(scene2, pts, 4, &bad), EDGEFEM_ERROR_INVALID_ARGUMENT, "count is 4",
+                 "render points not in threes");
+    CHECK_OK(edgefem_embedding_create(scene2, pts, 3, &bad));
+    expect_error(edgefem_sim_embedded_positions(sim, bad, y, 3), EDGEFEM_ERROR_INVALID_ARGUMENT, "27 vertices",
+                 "embedding of another mesh");
+    edgefem_embedding_destroy(bad);
+    edgefem_scene_destroy(scene2);
+
+    /* normals: a unit square in z = 0 as two triangles wound counter-clockwise
+     * seen from +z, and a fifth vertex no triangle uses */
+    const int32_t tri[] = {0, 1, 2, 0, 2, 3};
+    const double P[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 5, 5, 5};
+    double N[15];
+    CHECK_OK(edgefem_vertex_normals(tri, 2, P, 5, N));
+    for (int v = 0; v < 4; ++v) CHECK(N[3 * v] == 0 && N[3 * v + 1] == 0 && fabs(N[3 * v + 2] - 1) < 1e-15);
+    CHECK(N[12] == 0 && N[13] == 0 && N[14] == 0);
+    const int32_t tri_bad[] = {0, 1, 5};
+    expect_error(edgefem_vertex_normals(tri_bad, 1, P, 5, N), EDGEFEM_ERROR_INVALID_ARGUMENT, "triangles[2] = 5",
+                 "normals of a triangle past the vertices");
+    edgefem_embedding_destroy(e);
+    edgefem_embedding_destroy(e); /* a second destroy is ignored */
+    edgefem_embedding_destroy(NULL);
+    edgefem_sim_destroy(sim);
+    free(u);
+    free(X);
+    free(T);
+}
+
 int main(void) {
     printf("edgefem %s, C API %d\n", edgefem_version_string(), EDGEFEM_C_API_VERSION);
     double* X;
@@ -491,6 +569,7 @@ int main(void) {
     edgefem_scene_destroy(stiff);
 
     test_surfaces_regions_loads();
+    test_embedding();
 
     /* The simulation still works after all that. */
     CHECK_OK(edgefem_sim_step(sim, NULL));

@@ -131,6 +131,8 @@ typedef struct edgefem_energies {
 typedef struct edgefem_scene edgefem_scene;
 /** A running simulation (opaque). */
 typedef struct edgefem_sim edgefem_sim;
+/** A render surface's points placed in a scene's tets (opaque). */
+typedef struct edgefem_embedding edgefem_embedding;
 
 /** The library version, e.g. "0.1.0" (static storage). */
 EDGEFEM_C_EXPORT const char* edgefem_version_string(void);
@@ -391,6 +393,34 @@ EDGEFEM_C_EXPORT edgefem_status edgefem_sim_save_checkpoint(edgefem_sim* sim, co
  *  EDGEFEM_ERROR_FILE with a message naming the file and the difference; the
  *  state is then unchanged. */
 EDGEFEM_C_EXPORT edgefem_status edgefem_sim_load_checkpoint(edgefem_sim* sim, const char* path);
+
+/* ---- Render surfaces (docs/api.md, "Surfaces for rendering") ------------ */
+
+/** Places the points of a separate render surface (count = 3 x points,
+ *  finite) in the scene's tets: each point then moves with its tet (a point
+ *  outside the mesh with its nearest tet, affinely). The embedding keeps a
+ *  copy of the mesh, so the scene may be destroyed first. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_embedding_create(const edgefem_scene* scene, const double* points, size_t count,
+                                                         edgefem_embedding** out);
+/** Frees an embedding (NULL, or one already destroyed, is ignored). */
+EDGEFEM_C_EXPORT void edgefem_embedding_destroy(edgefem_embedding* embedding);
+/** The number of points it places. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_embedding_num_points(const edgefem_embedding* embedding, size_t* num_points);
+/** How far outside the mesh each point lies (count = points; 0 inside its
+ *  tet, else an estimate in metres). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_embedding_get_outside(const edgefem_embedding* embedding, double* out,
+                                                              size_t count);
+/** The embedded points at the simulation's current displacement
+ *  (count = 3 x points). The simulation must run on the mesh the embedding
+ *  was made for (same vertex count). */
+EDGEFEM_C_EXPORT edgefem_status edgefem_sim_embedded_positions(const edgefem_sim* sim,
+                                                               const edgefem_embedding* embedding, double* out,
+                                                               size_t count);
+/** Area-weighted unit vertex normals of a triangle mesh: triangles
+ *  (3 x num_triangles vertex indices, each in [0, num_vertices)), positions
+ *  and normals (3 x num_vertices each); 0 for a vertex no triangle uses. */
+EDGEFEM_C_EXPORT edgefem_status edgefem_vertex_normals(const int32_t* triangles, size_t num_triangles,
+                                                       const double* positions, size_t num_vertices, double* normals);
 
 #ifdef __cplusplus
 }
