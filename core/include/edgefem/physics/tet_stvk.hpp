@@ -51,13 +51,15 @@ EDGEFEM_FORMULA void green_strain(const T (&H)[3][3], T (&G)[3][3]) {
 }
 
 // The StVK second Piola-Kirchhoff stress S = 2 mu G + lambda tr(G) I
-// (volume-scaled when lambda and mu are).
+// (volume-scaled when lambda and mu are); returns tr(G), which the energy
+// needs too.
 template <class T>
-EDGEFEM_FORMULA void stvk_stress(const T (&G)[3][3], T lambda, T mu, T (&Sv)[3][3]) {
+EDGEFEM_FORMULA T stvk_stress(const T (&G)[3][3], T lambda, T mu, T (&Sv)[3][3]) {
     const T tr = G[0][0] + G[1][1] + G[2][2];
     const T two_mu = 2 * mu, ltr = lambda * tr;
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) Sv[i][j] = two_mu * G[i][j] + (i == j ? ltr : T{});
+    return tr;
 }
 
 // From the displacements U[i] of the tet's vertices and Dm^-1 (rows
@@ -68,9 +70,8 @@ EDGEFEM_FORMULA void tet_deformation(const T (&U)[4][3], const T (&Dinv)[3][3], 
     displacement_gradient(U, Dinv, d.H);
     T G[3][3];
     green_strain<S>(d.H, G);
-    stvk_stress(G, vol_lambda, vol_mu, d.Sv);
+    [[maybe_unused]] const T tr = stvk_stress(G, vol_lambda, vol_mu, d.Sv);
     if constexpr (Energy) {
-        const T tr = G[0][0] + G[1][1] + G[2][2];
         const T off = G[0][1] * G[0][1] + G[0][2] * G[0][2] + G[1][2] * G[1][2];
         const T GG = G[0][0] * G[0][0] + G[1][1] * G[1][1] + G[2][2] * G[2][2] + 2 * off;
         d.energy = S(0.5) * vol_lambda * tr * tr + vol_mu * GG;
