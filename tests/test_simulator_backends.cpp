@@ -265,8 +265,8 @@ CgRun run_cg(const VectorKernels<double>& k, const Inputs& in, int fixed_iterati
 
 // |P(b - A x)| / |P b|.
 double chain_residual(const Inputs& in, const std::vector<double>& x) {
-    const auto& k = make_reference_backend<double>()->kernels();
-    ChainSystem A(k, in);
+    const auto backend = make_reference_backend<double>();  // alive while its kernels are used
+    ChainSystem A(backend->kernels(), in);
     std::vector<double> Ax(kDofs);
     A.products(x.data(), Ax.data());
     A.finish(0, kDofs, x.data(), Ax.data());
