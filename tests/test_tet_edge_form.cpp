@@ -73,9 +73,17 @@ TEST(TetEdgeForm, EdgesAreTheTetsEdges) {
             std::sort(b.begin(), b.end());
             ASSERT_EQ(a, b) << name << " tet " << t;
         }
-        for (index_t t = topo.num_tets; t < form.num_batches() * kTetLanes<double>; ++t)
+        // Padding lanes: A = 0, and only edges that lane 0 of their batch
+        // reads (the kernels load every lane; another edge may be another
+        // thread's, written while it is read).
+        constexpr int L = kTetLanes<double>;
+        for (index_t t = topo.num_tets; t < form.num_batches() * L; ++t) {
+            const index_t b = t / L;
             for (int r = 0; r < kFormRows; ++r)
-                ASSERT_EQ(form.A[(t / kTetLanes<double> * kFormRows + r) * kTetLanes<double> + t % kTetLanes<double>], 0.0) << name;
+                ASSERT_EQ(form.A[(b * kFormRows + r) * L + t % L], 0.0) << name;
+            for (int k = 0; k < 6; ++k)
+                ASSERT_EQ(form.edge[(b * 6 + k) * L + t % L], form.edge[(b * 6 + k) * L]) << name << " lane " << t % L;
+        }
     }
 }
 

@@ -78,6 +78,15 @@ TetEdgeForm<S> make_tet_edge_form(const Mesh& mesh, const Topology& topo, const 
             for (int m = k + 1; m < 6; ++m) f.A[(b * kFormRows + kSym[k][m]) * L + lane] = S(A[k][m]);
         }
     }
+    // Padding lanes of the last batch (A = 0) repeat lane 0's edges: the
+    // kernels load every lane's zeta or p~, and an edge the batch reads
+    // anyway is one the parallel variants order before it (edge 0 was
+    // another thread's, read while it wrote: a data race, ThreadSanitizer
+    // on the owner variant, 2026-11-27).
+    if (const index_t real = f.num_tets % L; real != 0)
+        for (int k = 0; k < 6; ++k)
+            for (index_t lane = real; lane < L; ++lane)
+                f.edge[((nb - 1) * 6 + k) * L + lane] = f.edge[((nb - 1) * 6 + k) * L];
     f.tiles = plan_form_tiles(f, topo.edges, topo.first_edge, kFormTileBatches);
     // Without locality (a shuffled numbering: the first tile already needs
     // half the edges' strains) tiles save nothing: bunny-1m shuffled ran

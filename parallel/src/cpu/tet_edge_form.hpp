@@ -73,7 +73,7 @@ struct TetEdgeForm {
     index_t num_tets = 0;
     index_t num_edges = 0;
     // Batch b, local edge k, lane l: edge[(b * 6 + k) * kTetLanes<S> + l]. Lanes
-    // past num_tets in the last batch hold edge 0 and A = 0.
+    // past num_tets in the last batch repeat lane 0's edges, with A = 0.
     std::vector<index_t> edge;
     // A[(b * kFormRows + kSym[k][l]) * kTetLanes<S> + lane].
     std::vector<S> A;
