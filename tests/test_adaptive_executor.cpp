@@ -16,6 +16,7 @@
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/adaptive_executor.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "cpu/cpu_operator.hpp"
 #include "cantilever.hpp"
 #include "test_threads.hpp"
@@ -57,7 +58,7 @@ TEST(AdaptiveExecutor, EveryChunkOnceAndPhasesInOrder) {
     const std::vector<index_t> chunks{3, 0, 1, 16, 2};
     std::vector<index_t> first{0};
     for (index_t n : chunks) first.push_back(first.back() + n);
-    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB})
+    for (ExecutorKind b : test::threaded_executor_kinds())
         for (int t : {2, 3}) {
             const AdaptiveExecutor ex(make_executor(b, t), 2);
             // Past the trial calls, so both modes run.

@@ -21,6 +21,7 @@
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "cantilever.hpp"
 #include "operator_outputs.hpp"
 #include "test_meshes.hpp"
@@ -47,7 +48,7 @@ std::vector<Config> cpu_configs() {
     for (StiffnessLayout layout : {StiffnessLayout::TetLocal, StiffnessLayout::TsepList}) {
         const std::string l = std::string("/") + to_string(layout);
         c.push_back({"serial-loops" + l, {nullptr, Variant::Auto, layout}});
-        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+        for (ExecutorKind b : test::threaded_executor_kinds())
             for (int t : {1, 2, 3})
                 for (Variant v : {Variant::Auto, Variant::Colour, Variant::Gather, Variant::Atomic, Variant::Private,
                                   Variant::Owner}) {

@@ -13,13 +13,14 @@
 #include "edgefem/core/error.hpp"
 #include "lab/barrier_latency.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "cpu/variant.hpp"
 #include "test_threads.hpp"
 
 using namespace edgefem;
 
 TEST(Executors, EveryChunkOnce) {
-    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+    for (ExecutorKind b : test::executor_kinds())
         for (int t : {1, 2, 3, 8})
             for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
                 const auto ex = make_executor(b, t, s);
@@ -39,7 +40,7 @@ TEST(Executors, PhasesRunOnceAndInOrder) {
     const std::vector<index_t> chunks{3, 0, 1, 16, 2, 5};
     std::vector<index_t> first{0};  // the offsets for_phases takes
     for (index_t n : chunks) first.push_back(first.back() + n);
-    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+    for (ExecutorKind b : test::executor_kinds())
         for (int t : {1, 2, 3, 8})
             for (Schedule s : {Schedule::Static, Schedule::Dynamic}) {
                 const auto ex = make_executor(b, t, s);
@@ -72,7 +73,7 @@ TEST(Executors, LinkedPhasesHonourTheirLinks) {
     for (index_t c = 0; c < n; ++c) first.push_back(c), last.push_back(std::min<index_t>(c + 1, n - 1));
     for (index_t c = 0; c < n; ++c) first.push_back(0), last.push_back(c);
     for (index_t c = 0; c < n; ++c) first.push_back(-5), last.push_back(n + 5);
-    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+    for (ExecutorKind b : test::executor_kinds())
         for (int t : {1, 2, 3, 8}) {
             const auto ex = make_executor(b, t);
             for (int call = 0; call < 3; ++call) {  // the pool counts on from call to call
@@ -124,7 +125,7 @@ TEST(Executors, BlockedSumIndependentOfThreads) {
     std::vector<double> a(n);
     for (std::size_t i = 0; i < n; ++i) a[i] = std::sin(0.37 * double(i)) * std::exp(double(i % 97) / 7);
     const double ref = blocked_sum(SerialExecutor{}, n, [&](std::size_t i) { return a[i]; });
-    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+    for (ExecutorKind b : test::threaded_executor_kinds())
         for (int t : edgefem::test::test_thread_counts()) {
             const auto ex = make_executor(b, t);
             EXPECT_EQ(blocked_sum(*ex, n, [&](std::size_t i) { return a[i]; }), ref);
@@ -138,7 +139,7 @@ TEST(Executors, ForBlocksVisitEveryIndexOnce) {
     const std::size_t B = kVectorBlock;
     for (std::size_t n : {std::size_t(0), std::size_t(1), B - 1, B, B + 1, kMinParallelBlocks * B - 1,
                           kMinParallelBlocks * B, kMinParallelBlocks * B + 7, std::size_t(100003)})
-        for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+        for (ExecutorKind b : test::executor_kinds())
             for (Schedule sc : {Schedule::Static, Schedule::Dynamic})
                 for (int t : {1, 2, 3, 8}) {
                     const auto ex = make_executor(b, t, sc);
@@ -205,7 +206,7 @@ TEST(Executors, ConjugateGradientSameBitsOnEveryExecutor) {
         }
     }
     EXPECT_LT(worst, 1e-9 * bmax);
-    for (ExecutorKind bk : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+    for (ExecutorKind bk : test::threaded_executor_kinds())
         for (Schedule sc : {Schedule::Static, Schedule::Dynamic})
             for (int t : {1, 2, 3, 8}) {
                 std::vector<double> x;
@@ -219,7 +220,7 @@ TEST(Executors, ConjugateGradientSameBitsOnEveryExecutor) {
 // The barrier probe runs on every executor, and says what is wrong with
 // its arguments.
 TEST(Executors, PhaseBarrierProbe) {
-    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool}) {
+    for (ExecutorKind b : test::executor_kinds()) {
         const auto ex = make_executor(b, 2);
         const double us = phase_barrier_us(*ex, 50, 3);
         EXPECT_TRUE(std::isfinite(us) && us >= 0) << to_string(b) << " " << us;
@@ -234,7 +235,7 @@ TEST(Executors, Names) {
     EXPECT_EQ(parse_executor_kind("openmp"), ExecutorKind::OpenMP);
     EXPECT_EQ(parse_executor_kind("tbb"), ExecutorKind::TBB);
     EXPECT_THROW(parse_executor_kind("cuda"), InvalidArgument);
-    for (ExecutorKind b : {ExecutorKind::Serial, ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool}) EXPECT_EQ(parse_executor_kind(to_string(b)), b);
+    for (ExecutorKind b : test::executor_kinds()) EXPECT_EQ(parse_executor_kind(to_string(b)), b);
     for (Variant v : kAllVariants)
         EXPECT_EQ(parse_variant(to_string(v)), v);
     EXPECT_EQ(parse_variant("color"), Variant::Colour);
@@ -249,7 +250,7 @@ TEST(Executors, Names) {
 // OpenMP starts as many threads as asked (1e5 crashed in libgomp): past
 // kMaxThreads both back-ends refuse; oversubscription below it is fine.
 TEST(Executors, ThreadLimit) {
-    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool}) {
+    for (ExecutorKind b : test::threaded_executor_kinds()) {
         EXPECT_THROW(make_executor(b, kMaxThreads + 1), InvalidArgument) << to_string(b);
         EXPECT_THROW(make_executor(b, 100000), InvalidArgument) << to_string(b);
         EXPECT_EQ(make_executor(b, 16)->threads(), 16) << to_string(b);
@@ -259,6 +260,7 @@ TEST(Executors, ThreadLimit) {
 
 // Two TBB executors with different thread counts coexist (each its arena).
 TEST(Executors, IndependentArenas) {
+    if (test::kThreadSanitizer) GTEST_SKIP() << "libtbb is not instrumented for ThreadSanitizer";
     const auto a = make_executor(ExecutorKind::TBB, 2), b = make_executor(ExecutorKind::TBB, 3);
     std::atomic<int> n{0};
     a->for_chunks(10, [&](index_t) { b->for_chunks(5, [&](index_t) { n.fetch_add(1); }); });

@@ -14,6 +14,7 @@
 #include "lab/deformations.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "cpu/parallel_edge_kernels.hpp"
 #include "cpu/parallel_tet_kernels.hpp"
 #include "models.hpp"
@@ -44,7 +45,7 @@ struct NamedExecutor {
 const std::vector<NamedExecutor>& executors() {
     static const auto list = [] {
         std::vector<NamedExecutor> v;
-        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+        for (ExecutorKind b : test::threaded_executor_kinds())
             for (int t : edgefem::test::test_thread_counts())
                 for (Schedule s : {Schedule::Dynamic, Schedule::Static}) {
                     if (s == Schedule::Static && t != 3) continue;  // one static run per backend

@@ -11,6 +11,7 @@
 #include "edgefem/core/inverted_tets.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "cpu/cpu_operator.hpp"
 #include "cantilever.hpp"
 #include "models.hpp"
@@ -62,7 +63,7 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
             const std::string tag = std::string(method == Method::Edge ? "edge/" : "tet/") + to_string(var);
             EXPECT_LE(rel_diff(serial.u, core.u), 1e-12) << tag;
             EXPECT_LE(rel_diff(serial.v, core.v), 1e-12) << tag;
-            for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+            for (ExecutorKind b : test::threaded_executor_kinds())
                 for (int t : edgefem::test::test_thread_counts()) {
                     const auto ex = make_executor(b, t);
                     const Result par = run(method, ex, cpu_operator_factory<double>({ex, var}));
@@ -83,7 +84,7 @@ TEST(ParallelSimulator, SemiImplicitStepDeterministic) {
 
 TEST(ParallelSimulator, InvertedTetCount) {
     Scene s = cantilever(Method::Edge);
-    const auto ex = make_executor(ExecutorKind::TBB, 3);
+    const auto ex = make_executor(test::kThreadSanitizer ? ExecutorKind::Pool : ExecutorKind::TBB, 3);
     std::vector<double> u(s.mesh.X.size(), 0.0);
     // Collapse a few vertices onto the origin: inverts or flattens some tets.
     for (int v = 0; v < 20; ++v)
@@ -140,7 +141,7 @@ TEST(ParallelSimulator, ImplicitAndStaticDeterministic) {
         const auto serial_ex = std::make_shared<SerialExecutor>();
         const std::vector<double> serial = run_both(serial_ex, cpu_operator_factory<double>({serial_ex, var}));
         EXPECT_LE(rel_diff(serial, core), 1e-9) << to_string(var);
-        for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+        for (ExecutorKind b : test::threaded_executor_kinds())
             for (int t : edgefem::test::test_thread_counts()) {
                 const auto ex = make_executor(b, t);
                 EXPECT_TRUE(bitwise_equal(run_both(ex, cpu_operator_factory<double>({ex, var})), serial))

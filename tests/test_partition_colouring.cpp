@@ -16,6 +16,7 @@
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "cpu/parallel_edge_kernels.hpp"
 #include "cpu/cpu_operator.hpp"
 #include "edgefem/partition/ordering.hpp"
@@ -274,7 +275,7 @@ TEST(PartitionColouring, VariableUnitsEqualToBlocksColourLikeBlocks) {
 
 TEST(PartitionColouring, KernelsMatchCoreAndAreBitwiseEqualAcrossThreads) {
     std::vector<std::pair<std::string, std::shared_ptr<const Executor>>> executors;
-    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+    for (ExecutorKind b : test::threaded_executor_kinds())
         for (int t : {1, 2, 3, 4}) executors.emplace_back(std::string(to_string(b)) + "-" + std::to_string(t), make_executor(b, t));
     for (const auto& pm : part_meshes()) {
         const auto models = test::make_models<double>(pm.mesh);

@@ -17,6 +17,7 @@
 #include "edgefem/core/backend.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"
 #include "cantilever.hpp"
 #include "models.hpp"
@@ -492,7 +493,7 @@ TEST(Backends, CpuBackendBitwiseAcrossThreadCounts) {
                                        base.state.end() - std::ptrdiff_t(u.size()));
         EXPECT_TRUE(bitwise_equal(u, tail));
     }
-    for (ExecutorKind b : {ExecutorKind::OpenMP, ExecutorKind::TBB, ExecutorKind::Pool})
+    for (ExecutorKind b : test::threaded_executor_kinds())
         for (int t : test::test_thread_counts()) {
             const auto ex = make_executor(b, t);
             const SimRun par = simulate(scene, gather_backend(ex), 2);

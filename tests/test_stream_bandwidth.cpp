@@ -16,6 +16,7 @@
 #include "cpu/tet_edge_form.hpp"
 #include "edgefem/core/topology.hpp"
 #include "edgefem/parallel/executors.hpp"
+#include "executor_kinds.hpp"
 #include "lab/stream_bandwidth.hpp"
 
 using namespace edgefem;
@@ -24,7 +25,7 @@ namespace {
 
 std::vector<std::shared_ptr<const Executor>> executors() {
     return {make_executor(ExecutorKind::Serial), make_executor(ExecutorKind::OpenMP, 1), make_executor(ExecutorKind::OpenMP, 2),
-            make_executor(ExecutorKind::OpenMP, 3), make_executor(ExecutorKind::TBB, 2)};
+            make_executor(ExecutorKind::OpenMP, 3), make_executor(test::kThreadSanitizer ? ExecutorKind::Pool : ExecutorKind::TBB, 2)};
 }
 
 }  // namespace
