@@ -477,6 +477,13 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
             std::printf("| %s | %g | edgefem SA-AMG (%d levels; build %.1f, refresh) | %.0f | %.2f | %.2f | %.2f | %.2f |\n",
                         m.c_str(), dt, sa.levels(), setup_sa[0], median(its_sa), refresh, median(t_sa),
                         refresh + median(t_sa), sa_bytes / k_bytes);
+            std::printf("|  |  | (hierarchy: dofs, P entries per fine row, A entries per row:");
+            for (int l = 0; l < sa.levels(); ++l) {
+                std::printf(" L%d %ld", l, long(sa.dofs(l)));
+                if (l + 1 < sa.levels()) std::printf(" P %.1f", double(sa.prolongator(l).nonZeros()) / double(sa.dofs(l)));
+                if (l > 0 && l + 1 < sa.levels()) std::printf(" A %.1f", double(sa.matrix(l).nonZeros()) / double(sa.dofs(l)));
+            }
+            std::printf(") |  |  |  |  |  |\n");
             if (!g_no_hypre) {
                 std::printf("| %s | %g | hypre BoomerAMG (systems, nodal) | %.0f | %.2f | %.2f | %.2f | - |\n", m.c_str(),
                             dt, median(its_h), median(setup_h), median(t_h), median(setup_h) + median(t_h));
