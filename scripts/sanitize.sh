@@ -6,8 +6,8 @@
 # Any sanitizer report fails the test that triggered it (halt_on_error,
 # UBSan non-recoverable). Left out: install_consumer (it builds a separate
 # CMake project with plain flags against the instrumented static libraries,
-# which then lack the sanitizer runtime at link time), the tests that limit the address space
-# (ASan reserves terabytes of it), the Python tests (an instrumented
+# which then lack the sanitizer runtime at link time), the tests that limit
+# the address space, the Python tests (an instrumented
 # extension needs the sanitizer runtime preloaded into python3), and under
 # TSan without clang the OpenMP and TBB executors' tests. The CUDA
 # back-end (nvcc compiles its host code without the sanitizer) and the
@@ -26,25 +26,26 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 kind=${1:?usage: scripts/sanitize.sh address|thread [ctest args...]}
 shift
+# Both sanitizers reserve terabytes of address space: the tests that limit
+# it (ulimit -v, RLIMIT_AS) cannot run under them.
+address_space_tests='cli_error_out_of_memory|cli_error_box_memory_estimate|MemoryEstimateRefuses'
 case "$kind" in
     address)
         dir=build-asan
         flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -O1 -g"
-        # ASan reserves terabytes of address space: the tests that limit it
-        # (ulimit -v, RLIMIT_AS) cannot run under it.
-        exclude='^python_|^install_consumer$|cli_error_out_of_memory|cli_error_box_memory_estimate|MemoryEstimateRefuses'
+        exclude="^python_|^install_consumer\$|$address_space_tests"
         export ASAN_OPTIONS=${ASAN_OPTIONS:-halt_on_error=1:detect_leaks=1}
         export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
         ;;
     thread)
         dir=build-tsan
         flags="-fsanitize=thread -O1 -g"
-        exclude='^python_|^install_consumer$|omp|tbb|Omp|Tbb|OpenMP'
+        exclude="^python_|^install_consumer\$|$address_space_tests|omp|tbb|Omp|Tbb|OpenMP"
         export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:ignore_noninstrumented_modules=1}
         archer=$(ls /usr/lib/llvm-*/lib/libarcher.so 2>/dev/null | sort -V | tail -1 || true)
         if command -v clang++ >/dev/null && [ -n "$archer" ]; then
             export CC=clang CXX=clang++ OMP_TOOL_LIBRARIES=$archer
-            exclude='^python_|^install_consumer$'
+            exclude="^python_|^install_consumer\$|$address_space_tests"
         fi
         ;;
     *) echo "sanitize: expected 'address' or 'thread', got '$kind'" >&2; exit 2 ;;
