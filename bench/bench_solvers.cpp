@@ -16,6 +16,7 @@
 //   edgefem_bench_solvers [--meshes beam,bunny-4k] [--dts 1,4,10] [--rounds 9] [--parts direct,step,matrix]
 //                         [--amg-smoother chebyshev|l1] [--amg-smoothing N] [--amg-coarse DOFS]
 //                         [--amg-levels N] [--amg-ratio R] [--amg-weight W] [--amg-strength S] [--no-hypre] [--quick]
+//                         [--threads N]  (the step part on the pool back-end's N threads; default serial)
 // (--amg-*: AmgSettings' fields, for the step and matrix parts, to study the
 // hierarchy; unset ones keep SolverSettings' defaults)
 #include <HYPRE.h>
@@ -45,6 +46,7 @@
 #include "edgefem/core/sparse_assembly.hpp"
 #include "edgefem/core/sparse_cholesky.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"
+#include "edgefem/parallel/executors.hpp"
 #include "lab/benchmark_scene.hpp"
 
 using namespace edgefem;
@@ -72,6 +74,7 @@ double median(std::vector<double> v) {
 
 AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
 bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
+int g_threads = 1;                          // --threads N: the step part on the pool back-end's N threads
 
 std::string describe(const AmgSettings& a) {
     char buf[256];
@@ -228,9 +231,11 @@ void bench_direct(int rounds) {
 }
 
 void bench_steps(const std::vector<std::string>& meshes, const std::vector<double>& dts, int rounds) {
-    std::printf("\n## step: semi-implicit, CG to 1e-6, serial; medians of %d alternating steps (after one)\n\n"
+    const std::shared_ptr<const Executor> ex = g_threads > 1 ? make_executor(ExecutorKind::Pool, g_threads) : nullptr;
+    std::printf("\n## step: semi-implicit, CG to 1e-6, %s; medians of %d alternating steps (after one)\n\n"
                 "AMG: its Galerkin operators refreshed at every K (`amg_refresh_interval` 1) or lagged (0, the "
-                "default: refreshed when the iterations grow 1.5x).\n\n", rounds);
+                "default: refreshed when the iterations grow 1.5x).\n\n",
+                ex ? ("pool x" + std::to_string(g_threads)).c_str() : "serial", rounds);
     std::printf("| mesh | dofs | dt ms | BJ its | AMG its (every K / lagged) | BJ ms/step | AMG ms/step (every K / lagged) | "
                 "lagged AMG / BJ | BJ set-up ms | AMG set-up ms (every K / lagged) | AMG first step ms |\n");
     std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -243,9 +248,9 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
             for_solve(sl, dt, PreconditionerKind::Amg);
             sa.solver.amg_refresh_interval = 1;
             sl.solver.amg_refresh_interval = 0;
-            Simulator<double> bj(sb, nullptr, cpu_operator_factory<double>());
-            Simulator<double> amg(sa, nullptr, cpu_operator_factory<double>());
-            Simulator<double> lag(sl, nullptr, cpu_operator_factory<double>());
+            Simulator<double> bj(sb, ex, cpu_operator_factory<double>());
+            Simulator<double> amg(sa, ex, cpu_operator_factory<double>());
+            Simulator<double> lag(sl, ex, cpu_operator_factory<double>());
             bj.step();
             lag.step();
             auto t0 = Clock::now();
@@ -526,6 +531,7 @@ int main(int argc, char** argv) {
         else if (a == "--amg-smoothing") g_amg.smoothing_steps = std::max(1, std::stoi(next()));
         else if (a == "--amg-coarse") g_amg.max_coarse_dofs = std::max(1, std::stoi(next()));
         else if (a == "--no-hypre") g_no_hypre = true;
+        else if (a == "--threads") g_threads = std::max(1, std::stoi(next()));
         else if (a == "--amg-levels") g_amg.max_levels = std::max(1, std::stoi(next()));
         else if (a == "--amg-ratio") g_amg.chebyshev_ratio = std::stod(next());
         else if (a == "--amg-weight") g_amg.prolongator_weight = std::stod(next());

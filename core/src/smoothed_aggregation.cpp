@@ -5,6 +5,7 @@
 #include <string>
 
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/executor.hpp"
 #include "edgefem/core/sparse_cholesky.hpp"
 
 namespace edgefem {
@@ -188,9 +189,11 @@ SparseRows block_diagonal(const std::vector<double>& Dinv, int bs, Eigen::Index 
 
 // y = f D^-1 v + keep y, D^-1 given by its bs x bs inverse blocks (keep 0:
 // y overwritten).
-void block_apply(const std::vector<double>& Dinv, int bs, const double* v, double* y, double f, double keep) {
-    const std::size_t bb = std::size_t(bs * bs), nodes = Dinv.size() / bb;
-    for (std::size_t i = 0; i < nodes; ++i) {
+// Nodes [first, last) only (block_apply_range), or all of them.
+void block_apply_range(const std::vector<double>& Dinv, int bs, const double* v, double* y, double f, double keep,
+                       std::size_t first, std::size_t last) {
+    const std::size_t bb = std::size_t(bs * bs);
+    for (std::size_t i = first; i < last; ++i) {
         const double* m = &Dinv[i * bb];
         const double* vi = v + i * std::size_t(bs);
         double* yi = y + i * std::size_t(bs);
@@ -200,6 +203,9 @@ void block_apply(const std::vector<double>& Dinv, int bs, const double* v, doubl
             yi[a] = keep == 0 ? f * s : keep * yi[a] + f * s;
         }
     }
+}
+void block_apply(const std::vector<double>& Dinv, int bs, const double* v, double* y, double f, double keep) {
+    block_apply_range(Dinv, bs, v, y, f, keep, 0, Dinv.size() / std::size_t(bs * bs));
 }
 
 // The largest eigenvalue of D^-1 A, D^-1 given by its inverse blocks, by
@@ -252,20 +258,55 @@ struct CompactRows {
             start[std::size_t(i) + 1] = int(col.size());
         }
     }
-    // y = M x, or y += M x with accumulate
-    void times(const double* x, double* y, bool accumulate = false) const {
-        for (Eigen::Index i = 0; i < rows; ++i) {
+    // y = M x, or y += M x with accumulate, rows [r0, r1)
+    void times(const double* x, double* y, bool accumulate, std::size_t r0, std::size_t r1) const {
+        for (Eigen::Index i = Eigen::Index(r0); i < Eigen::Index(r1); ++i) {
             double s = 0;
             for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) s += double(val[std::size_t(k)]) * x[col[std::size_t(k)]];
             y[i] = accumulate ? y[i] + s : s;
         }
     }
-    // y = M^T x
+    // y = M^T x, scattered row by row. Fused multiply-adds, spelt out:
+    // gather_times on the stored transpose adds the same terms in the same
+    // order, and the two must round alike (g++ fused the scatter's update on
+    // its own and not the gather's sum).
     void transpose_times(const double* x, double* y) const {
         std::fill(y, y + cols, 0.0);
         for (Eigen::Index i = 0; i < rows; ++i)
-            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k)
-                y[col[std::size_t(k)]] += double(val[std::size_t(k)]) * x[i];
+            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) {
+                double& yc = y[col[std::size_t(k)]];
+                yc = std::fma(double(val[std::size_t(k)]), x[i], yc);
+            }
+    }
+    // Rows [r0, r1) of y = M x for M = transposed() of a matrix N: bitwise
+    // N.transpose_times(x, y) there.
+    void gather_times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
+        for (std::size_t i = r0; i < r1; ++i) {
+            double s = 0;
+            for (int k = start[i]; k < start[i + 1]; ++k) s = std::fma(double(val[std::size_t(k)]), x[col[std::size_t(k)]], s);
+            y[i] = s;
+        }
+    }
+    // M^T with each row's entries in increasing column order: row j of it
+    // times x adds the terms of column j in the order transpose_times adds
+    // them (bitwise the same y).
+    CompactRows transposed() const {
+        CompactRows t;
+        t.rows = cols;
+        t.cols = rows;
+        t.start.assign(std::size_t(cols) + 1, 0);
+        for (int c : col) ++t.start[std::size_t(c) + 1];
+        for (std::size_t j = 0; j < std::size_t(cols); ++j) t.start[j + 1] += t.start[j];
+        t.col.resize(col.size());
+        t.val.resize(val.size());
+        std::vector<int> next(t.start.begin(), t.start.end() - 1);
+        for (Eigen::Index i = 0; i < rows; ++i)
+            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) {
+                const int at = next[std::size_t(col[std::size_t(k)])]++;
+                t.col[std::size_t(at)] = int(i);
+                t.val[std::size_t(at)] = val[std::size_t(k)];
+            }
+        return t;
     }
     SparseRows expand() const {
         std::vector<Eigen::Triplet<double>> t;
@@ -331,7 +372,8 @@ struct SmoothedAggregation::Impl {
     struct Level {
         int bs = 3;
         CompactRows A;         // level >= 1 and not the coarsest: R A P of the level above
-        CompactRows P;         // to the next level (R = P^T is not stored)
+        CompactRows P;         // to the next level
+        CompactRows R;         // P^T, with a threaded executor only (its rows in parallel; else P's scatter)
         SparseRows P_tent;     // before smoothing (build only; release_build_data() frees it)
         Eigen::MatrixXd B;     // near-nullspace, dofs x 6
         std::vector<double> Minv;  // the smoother's inverse blocks (D^-1, or l1 block-Jacobi's)
@@ -342,29 +384,49 @@ struct SmoothedAggregation::Impl {
     std::vector<Level> level;
     SparseCholesky coarse;
     mutable Eigen::VectorXd coarse_rhs;
+    std::shared_ptr<const Executor> ex;  // null or one thread: serial
+
+    bool threaded() const { return ex && ex->threads() > 1; }
+    // body(begin, end) over [0, n) in the fixed blocks of for_blocks (their
+    // ends are multiples of 384: whole 3- and 6-dof nodes), on the executor.
+    template <class Body>
+    void par(Eigen::Index n, const Body& body) const {
+        if (!threaded()) return body(std::size_t(0), std::size_t(n));
+        for_blocks(*ex, std::size_t(n), body);
+    }
+    void blocks(const Level& L, const double* v, double* y, double f, double keep) const {
+        const std::size_t bs = std::size_t(L.bs);
+        par(Eigen::Index(L.Minv.size() / bs), [&](std::size_t b, std::size_t e) {
+            block_apply_range(L.Minv, L.bs, v, y, f, keep, b / bs, e / bs);
+        });
+    }
 
     // x += S (b - A x), S the smoother (zero: x = S b without a product):
     // l1 block-Jacobi sweeps, or the Chebyshev iteration (Saad, Iterative
     // Methods, Alg. 12.1) preconditioned by D^-1 on [beta / ratio, beta]:
     // x += p(D^-1 A) D^-1 (b - A x), S = p(D^-1 A) D^-1 symmetric. Products
-    // with A and axpys only.
+    // with A and axpys only, each entry by itself: bitwise the same on any
+    // executor.
     template <class Product>
     void smooth(const Level& L, const double* b, double* x, bool zero, const Product& product) const {
         const Eigen::Index n = Eigen::Index(L.Minv.size() / std::size_t(L.bs));
         const int steps = settings.smoothing_steps;
         L.r.resize(n);
+        double* r = L.r.data();
         const auto residual = [&] {
-            product(x, L.r.data());
-            for (Eigen::Index i = 0; i < n; ++i) L.r[i] = b[i] - L.r[i];
+            product(x, r);
+            par(n, [&](std::size_t i0, std::size_t i1) {
+                for (std::size_t i = i0; i < i1; ++i) r[i] = b[i] - r[i];
+            });
         };
         if (settings.smoother == AmgSmoother::L1Jacobi) {
             for (int s = 0; s < steps; ++s) {
                 if (s == 0 && zero) {
-                    block_apply(L.Minv, L.bs, b, x, 1.0, 0.0);
+                    blocks(L, b, x, 1.0, 0.0);
                     continue;
                 }
                 residual();
-                block_apply(L.Minv, L.bs, L.r.data(), x, 1.0, 1.0);
+                blocks(L, r, x, 1.0, 1.0);
             }
             return;
         }
@@ -372,21 +434,28 @@ struct SmoothedAggregation::Impl {
         const double theta = (beta + alpha) / 2, delta = (beta - alpha) / 2, sigma = theta / delta;
         double rho = 1 / sigma;
         if (zero) {
-            std::fill(x, x + n, 0.0);
-            std::copy(b, b + n, L.r.data());
+            par(n, [&](std::size_t i0, std::size_t i1) {
+                std::fill(x + i0, x + i1, 0.0);
+                std::copy(b + i0, b + i1, r + i0);
+            });
         } else {
             residual();
         }
         L.d.resize(n);
         L.t.resize(n);
-        block_apply(L.Minv, L.bs, L.r.data(), L.d.data(), 1 / theta, 0.0);
+        double *d = L.d.data(), *t = L.t.data();
+        blocks(L, r, d, 1 / theta, 0.0);
         for (int k = 1;; ++k) {
-            for (Eigen::Index i = 0; i < n; ++i) x[i] += L.d[i];
+            par(n, [&](std::size_t i0, std::size_t i1) {
+                for (std::size_t i = i0; i < i1; ++i) x[i] += d[i];
+            });
             if (k == steps) break;
-            product(L.d.data(), L.t.data());
-            L.r -= L.t;
+            product(d, t);
+            par(n, [&](std::size_t i0, std::size_t i1) {
+                for (std::size_t i = i0; i < i1; ++i) r[i] -= t[i];
+            });
             const double rho_next = 1 / (2 * sigma - rho);
-            block_apply(L.Minv, L.bs, L.r.data(), L.d.data(), 2 * rho_next / delta, rho_next * rho);
+            blocks(L, r, d, 2 * rho_next / delta, rho_next * rho);
             rho = rho_next;
         }
     }
@@ -395,8 +464,8 @@ struct SmoothedAggregation::Impl {
     auto product(std::size_t l, const std::function<void(const double*, double*)>& fine) const {
         return [this, l, &fine](const double* in, double* out) {
             const Level& L = level[l];
-            if (l == 0) fine(in, out);
-            else L.A.times(in, out);
+            if (l == 0) return fine(in, out);
+            par(L.A.rows, [&](std::size_t i0, std::size_t i1) { L.A.times(in, out, false, i0, i1); });
         };
     }
 
@@ -410,14 +479,20 @@ struct SmoothedAggregation::Impl {
         }
         const auto product = this->product(l, fine);
         smooth(L, b, x, true, product);
-        product(x, L.r.data());
-        for (Eigen::Index i = 0; i < n; ++i) L.r[i] = b[i] - L.r[i];
+        double* r = L.r.data();
+        product(x, r);
+        par(n, [&](std::size_t i0, std::size_t i1) {
+            for (std::size_t i = i0; i < i1; ++i) r[i] = b[i] - r[i];
+        });
         const Level& C = level[l + 1];
         C.b.resize(L.P.cols);
-        L.P.transpose_times(L.r.data(), C.b.data());
+        if (L.R.rows == L.P.cols && L.R.cols == L.P.rows && threaded())
+            par(L.R.rows, [&](std::size_t i0, std::size_t i1) { L.R.gather_times(r, C.b.data(), i0, i1); });
+        else
+            L.P.transpose_times(r, C.b.data());
         C.x.resize(C.b.size());
         cycle(l + 1, C.b.data(), C.x.data(), fine);
-        L.P.times(C.x.data(), x, true);
+        par(L.P.rows, [&](std::size_t i0, std::size_t i1) { L.P.times(C.x.data(), x, true, i0, i1); });
         smooth(L, b, x, false, product);
     }
 };
@@ -489,6 +564,7 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         const double rho = largest_eigenvalue(Al, Dinv, bs, settings.power_iterations);
         const SparseRows P = L.P_tent - (settings.prolongator_weight / rho) * SparseRows(DinvA * L.P_tent);
         L.P.assign(P);
+        if (m.threaded()) L.R = L.P.transposed();
         const SparseRows Pf = L.P.expand();  // the rounded P, as refresh() and apply() use it
         SparseRows Ac = SparseRows(Pf.transpose()) * Al * Pf;
         m.level.emplace_back();
@@ -523,6 +599,12 @@ void SmoothedAggregation::refresh(const SparseRows& A) {
                 throw Error("AMG: the coarsest level's factorisation failed (a zero pivot)");
         }
     }
+}
+
+void SmoothedAggregation::set_executor(std::shared_ptr<const Executor> ex) {
+    impl_->ex = std::move(ex);
+    for (auto& L : impl_->level)
+        if (impl_->threaded() && L.P.rows > 0 && L.R.rows == 0) L.R = L.P.transposed();
 }
 
 void SmoothedAggregation::apply(const double* r, double* z, const std::function<void(const double*, double*)>& fine) const {
@@ -561,7 +643,7 @@ std::size_t SmoothedAggregation::bytes() const {
     const auto vec = [](const Eigen::VectorXd& v) { return std::size_t(v.size()) * sizeof(double); };
     std::size_t b = 0;
     for (const auto& L : impl_->level)
-        b += L.A.bytes() + L.P.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
+        b += L.A.bytes() + L.P.bytes() + L.R.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
              L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t);
     b += std::size_t(impl_->coarse.factor_nonzeros() * sizeof(double));
     return b;

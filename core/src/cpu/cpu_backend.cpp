@@ -39,6 +39,7 @@ public:
     }
     const VectorKernels<S>& kernels() const override { return kernels_; }
     const VectorMemory& memory() const override { return host_memory(); }
+    std::shared_ptr<const Executor> executor() const override { return ex_; }
 
 private:
     std::shared_ptr<const Executor> ex_;

@@ -8,7 +8,8 @@
 // 1.5x + 2 of those after the last refresh and the coefficients (the step
 // size) are unchanged. The finest level's products are the LinearSystem's
 // matrix-free ones (the per-edge K on the back-end's executor). A
-// whole-vector preconditioner: one V-cycle per CG iteration. On the host.
+// whole-vector preconditioner: one V-cycle per CG iteration. On the host,
+// on the back-end's executor (Backend::executor()) when it has one.
 #include <array>
 #include <string>
 
@@ -24,7 +25,10 @@ namespace {
 template <class S>
 class Amg final : public Preconditioner<S> {
 public:
-    explicit Amg(const SimState<S>& state) : s_(state), matrix_(state) { matrix_.keep(false, true); }
+    explicit Amg(const SimState<S>& state) : s_(state), ex_(state.backend->executor()), matrix_(state) {
+        matrix_.keep(false, true);
+        amg_.set_executor(ex_);  // the back-end's threads, bitwise as serial
+    }
 
     void setup(LinearSystem<S>& A) override {
         A_ = &A;
@@ -96,10 +100,16 @@ public:
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override {
         if (lo != 0 || hi != s_.n()) throw InvalidArgument("AMG preconditioner: applies to the whole vector only");
         const auto& fr = s_.free_host;
+        const auto mask = [&](std::size_t i0, std::size_t i1, double* y) {
+            for (std::size_t i = i0; i < i1; ++i)
+                if (!fr[i]) y[i] = 0;
+        };
         amg_.apply(r, z, [&](const double* x, double* y) {
             A_->apply(x, y);
-            for (std::size_t i = 0; i < fr.size(); ++i)
-                if (!fr[i]) y[i] = 0;
+            if (ex_ && ex_->threads() > 1)
+                for_blocks(*ex_, fr.size(), [&](std::size_t i0, std::size_t i1) { mask(i0, i1, y); });
+            else
+                mask(0, fr.size(), y);
         });
     }
 
@@ -107,6 +117,7 @@ public:
 
 private:
     const SimState<S>& s_;
+    std::shared_ptr<const Executor> ex_;  // the back-end's threads (null: serial)
     SystemMatrix<S> matrix_;
     SmoothedAggregation amg_;
     LinearSystem<S>* A_ = nullptr;

@@ -37,6 +37,9 @@ public:
                                                               ModelKind model, Method method) const = 0;
     virtual const VectorKernels<S>& kernels() const = 0;
     virtual const VectorMemory& memory() const = 0;
+    // The host threads its kernels run on, for host-side solvers that can
+    // use them (the AMG preconditioner); null: none to share (serial).
+    virtual std::shared_ptr<const Executor> executor() const { return nullptr; }
     // n zeros in memory().
     template <class T>
     BackendVector<T> vector(std::size_t n) const {

@@ -8,7 +8,10 @@
 // reused) for a new A of the same pattern; apply() runs one symmetric
 // V-cycle (the smoothers are symmetric and only products and axpys), the finest level's
 // products through a caller's function (the matrix-free per-edge K). On the
-// host, serial apart from the caller's product.
+// host: on an executor's threads when set_executor() gives one (the vector
+// passes, the smoothers' blocks, the coarse products and the transfers in
+// the fixed blocks of for_blocks; the restriction then through a stored
+// P^T), bitwise the same for any executor and thread count.
 #pragma once
 
 #include <Eigen/SparseCore>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "edgefem/core/amg_settings.hpp"
+#include "edgefem/core/executor.hpp"
 #include "edgefem/core/mesh.hpp"
 
 namespace edgefem {
@@ -32,6 +36,10 @@ public:
     // A: the fine system over 3 #V dofs with the rows and columns of
     // constrained dofs zero; rest: 3 coordinates per vertex; free_dof: 1 on
     // unknowns. Builds the hierarchy, then refresh(A).
+    // Runs apply() and smooth() on `ex` (null: serial). With more than one
+    // thread P^T is stored as well (a gather instead of P's scatter): the
+    // prolongators' memory doubles.
+    void set_executor(std::shared_ptr<const Executor> ex);
     void build(const SparseRows& A, const std::vector<double>& rest, const std::vector<std::uint8_t>& free_dof,
                const AmgSettings& settings = {});
     // Galerkin operators, smoothers and coarsest factorisation for a new A
