@@ -38,6 +38,7 @@ struct Case {
     bool damping_and_prescribed = false;
     int amg_refresh = -1;  // >= 0: AMG with this refresh interval
     int stiffness_interval = 1;
+    int auto_threshold = 0;  // > 0: the auto preconditioner with this threshold (else block-Jacobi)
 };
 
 // 8 x 3 x 3 cubes (144 vertices: the AMG gets one coarse level), clamped at
@@ -58,9 +59,14 @@ Scene case_scene(const Case& c) {
                 s.prescribed.push_back({v, {s.mesh.X[3 * v] + 0.004, s.mesh.X[3 * v + 1], s.mesh.X[3 * v + 2] + 0.01}});
         s.prescribed_steps = 2 * kHalf + 3;  // still ramping at the checkpoint
     }
+    s.solver.preconditioner = PreconditionerKind::BlockJacobi;
     if (c.amg_refresh >= 0) {
         s.solver.preconditioner = PreconditionerKind::Amg;
         s.solver.amg_refresh_interval = c.amg_refresh;
+    }
+    if (c.auto_threshold > 0) {
+        s.solver.preconditioner = PreconditionerKind::Auto;
+        s.solver.auto_amg_iterations = c.auto_threshold;
     }
     s.solver.stiffness_interval = c.stiffness_interval;
     return s;
@@ -88,6 +94,11 @@ std::vector<Case> cases() {
     out.push_back({"semi_implicit_lagged3", Integrator::SemiImplicit, true, -1, 3});
     out.push_back({"semi_implicit_lagged3_amg2", Integrator::SemiImplicit, true, 2, 3});
     out.push_back({"newmark_linear_amg_lagged", Integrator::NewmarkLinear, false, 0});
+    // auto: AMG takes over after the first solve (threshold 1), before the
+    // checkpoint; with a threshold no solve reaches, block-Jacobi throughout.
+    out.push_back({"semi_implicit_auto_switch", Integrator::SemiImplicit, true, -1, 1, 1});
+    out.push_back({"bdf2_linear_auto_switch", Integrator::Bdf2Linear, true, -1, 1, 1});
+    out.push_back({"semi_implicit_auto_stays", Integrator::SemiImplicit, true, -1, 1, 100000});
     return out;
 }
 
@@ -153,7 +164,8 @@ std::vector<Case> cpu_cases() {
     std::vector<Case> out;
     for (const Case& c : cases())
         if (c.damping_and_prescribed && (c.amg_refresh < 0 || c.integrator == Integrator::Newmark ||
-                                         c.integrator == Integrator::Bdf2Linear || c.stiffness_interval > 1))
+                                         c.integrator == Integrator::Bdf2Linear || c.stiffness_interval > 1 ||
+                                         c.auto_threshold > 0))
             out.push_back(c);
     return out;
 }
@@ -260,7 +272,7 @@ TEST(Checkpoint, RefusesAnotherMeshIntegratorScalarOrNumbering) {
     Scene amg = error_scene();
     amg.solver.preconditioner = PreconditionerKind::Amg;
     Simulator<double> solver(amg);
-    expect_refused(solver, path, {"solver 'cg/block-jacobi'", "'cg/amg'"});
+    expect_refused(solver, path, {"solver 'cg/auto'", "'cg/amg'"});
 
     // An OrderedSimulator's state is in its ordering's numbering.
     RunOptions rcm;

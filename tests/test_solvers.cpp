@@ -419,6 +419,63 @@ TEST(Solvers, AmgNeedsFarFewerIterationsThanBlockJacobiAtALargeStep) {
     EXPECT_LT(4 * its[1], its[0]) << "block-Jacobi " << its[0] << ", AMG " << its[1];
 }
 
+namespace {
+
+struct AutoRun {
+    std::vector<double> u;
+    std::vector<int> its;
+};
+
+AutoRun run_steps(Scene s, PreconditionerKind kind, int steps, int threshold = 200) {
+    s.solver.preconditioner = kind;
+    s.solver.auto_amg_iterations = threshold;
+    Simulator<double> sim(std::move(s));
+    AutoRun r;
+    for (int k = 0; k < steps; ++k) r.its.push_back(sim.step().solver_iterations);
+    r.u.assign(sim.displacement().begin(), sim.displacement().end());
+    return r;
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
+}
+
+}  // namespace
+
+// auto (the default): block-Jacobi, bitwise, while its solves stay within
+// the threshold; past it, AMG from the next step on (far fewer iterations,
+// the same solution to the solver's tolerance); never with a fixed budget.
+TEST(Solvers, AutoPreconditionerSwitchesToAmgPastItsThreshold) {
+    EXPECT_EQ(SolverSettings{}.preconditioner, PreconditionerKind::Auto);
+    Scene s = test::clamped_box_scene(24, 6, 6, 1e6);
+    s.dt = 10e-3;
+    s.solver.cg_tolerance = 1e-10;
+    s.solver.cg_max_iterations = 5000;
+    const AutoRun bj = run_steps(s, PreconditionerKind::BlockJacobi, 4);
+    const AutoRun amg = run_steps(s, PreconditionerKind::Amg, 4);
+    ASSERT_GT(bj.its[0], 50);
+    // Within the threshold: block-Jacobi's bits.
+    const AutoRun below = run_steps(s, PreconditionerKind::Auto, 4, 100000);
+    EXPECT_TRUE(same_bits(below.u, bj.u));
+    EXPECT_EQ(below.its, bj.its);
+    // Past it after the first step: that step is block-Jacobi's, the others AMG's.
+    const AutoRun past = run_steps(s, PreconditionerKind::Auto, 4, bj.its[0] - 1);
+    EXPECT_EQ(past.its[0], bj.its[0]);
+    for (int k = 1; k < 4; ++k) {
+        EXPECT_LE(past.its[std::size_t(k)], amg.its[std::size_t(k)] + 2) << "step " << k;
+        EXPECT_LT(4 * past.its[std::size_t(k)], bj.its[std::size_t(k)]) << "step " << k;
+    }
+    double diff = 0, norm = 0;
+    for (std::size_t i = 0; i < bj.u.size(); ++i) {
+        diff += (past.u[i] - bj.u[i]) * (past.u[i] - bj.u[i]);
+        norm += bj.u[i] * bj.u[i];
+    }
+    EXPECT_LT(std::sqrt(diff / norm), 1e-8);
+    // A fixed CG budget keeps block-Jacobi whatever the threshold.
+    s.solver.cg_fixed_iterations = 30;
+    EXPECT_TRUE(same_bits(run_steps(s, PreconditionerKind::Auto, 3, 1).u, run_steps(s, PreconditionerKind::BlockJacobi, 3).u));
+}
+
 TEST(Solvers, DirectSolverAnalysesThePatternOnce) {
     for (const Integrator in : {Integrator::SemiImplicit, Integrator::Implicit}) {
         Scene s = test::cantilever_scene(in, 2e-3);
@@ -442,6 +499,7 @@ TEST(Solvers, DirectSolverAnalysesThePatternOnce) {
 
 TEST(Solvers, PreconditionerNamesAreCheckedAndNamed) {
     EXPECT_EQ(parse_preconditioner("amg"), PreconditionerKind::Amg);
+    EXPECT_EQ(parse_preconditioner("auto"), PreconditionerKind::Auto);
     EXPECT_EQ(parse_preconditioner("block-jacobi"), PreconditionerKind::BlockJacobi);
     try {
         parse_preconditioner("jacobi");
@@ -466,4 +524,16 @@ TEST(Solvers, PreconditionerNamesAreCheckedAndNamed) {
     } catch (const InvalidArgument& e) {
         EXPECT_NE(std::string(e.what()).find("solver.preconditioner"), std::string::npos) << e.what();
     }
+    s.solver.preconditioner = PreconditionerKind::Auto;
+    s.solver.auto_amg_iterations = 0;
+    try {
+        s.validate();
+        FAIL() << "no error";
+    } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("solver.auto_amg_iterations"), std::string::npos) << e.what();
+    }
+    const SceneFile a = parse_scene(R"({"mesh": "box:2x2x2", "solver": {"preconditioner": "auto", "auto_amg_iterations": 50}})",
+                                    "", "scene.json");
+    EXPECT_EQ(a.scene.solver.auto_amg_iterations, 50);
+    EXPECT_THROW(parse_scene(R"({"mesh": "box:2x2x2", "solver": {"auto_amg_iterations": 0}})", "", "scene.json"), Error);
 }

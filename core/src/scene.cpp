@@ -80,12 +80,15 @@ void check_per_dof(const std::string& field, const std::vector<double>& x, std::
 }
 }  // namespace
 
-const char* to_string(PreconditionerKind p) { return p == PreconditionerKind::Amg ? "amg" : "block-jacobi"; }
+const char* to_string(PreconditionerKind p) {
+    return p == PreconditionerKind::Amg ? "amg" : p == PreconditionerKind::Auto ? "auto" : "block-jacobi";
+}
 
 PreconditionerKind parse_preconditioner(const std::string& name, const std::string& key) {
+    if (name == "auto") return PreconditionerKind::Auto;
     if (name == "block-jacobi") return PreconditionerKind::BlockJacobi;
     if (name == "amg") return PreconditionerKind::Amg;
-    throw InvalidArgument(key + ": expected one of \"block-jacobi\", \"amg\", got \"" + name + "\"");
+    throw InvalidArgument(key + ": expected one of \"auto\", \"block-jacobi\", \"amg\", got \"" + name + "\"");
 }
 
 void Scene::validate() const {
@@ -123,8 +126,11 @@ void Scene::validate() const {
         bad("generalized_alpha.rho_inf", "must lie in [0, 1], got " + std::to_string(ip.rho_inf));
     if (solver.linear_solver != LinearSolver::CG && solver.linear_solver != LinearSolver::Direct)
         bad("solver.linear_solver", "not a linear solver (cg or direct)");
-    if (solver.preconditioner != PreconditionerKind::BlockJacobi && solver.preconditioner != PreconditionerKind::Amg)
-        bad("solver.preconditioner", "not a preconditioner (block-jacobi or amg)");
+    if (solver.preconditioner != PreconditionerKind::BlockJacobi && solver.preconditioner != PreconditionerKind::Amg &&
+        solver.preconditioner != PreconditionerKind::Auto)
+        bad("solver.preconditioner", "not a preconditioner (auto, block-jacobi or amg)");
+    if (solver.auto_amg_iterations < 1)
+        bad("solver.auto_amg_iterations", "must be >= 1, got " + std::to_string(solver.auto_amg_iterations));
     if (solver.amg_refresh_interval < 0) bad("solver.amg_refresh_interval", "must be >= 0 (0: adaptive)");
     materials.validate();
     for (int r = 0; r < 3; ++r)

@@ -443,7 +443,7 @@ Material read_material(const Context& cx, const json& v, const std::string& path
 void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     const std::string p = "solver";
     check_keys(cx, v, p,
-               {"linear", "preconditioner", "amg_refresh_interval", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "definite_stiffness",
+               {"linear", "preconditioner", "auto_amg_iterations", "amg_refresh_interval", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "definite_stiffness",
                 "newton_tolerance", "newton_max_iterations", "load_steps", "max_step_halvings",
                 "stiffness_interval", "fail_on_unconverged", "max_energy_growth", "fail_on_inverted"});
     if (const json* x = find(v, "fail_on_inverted")) s.fail_on_inverted = get_bool(cx, *x, join(p, "fail_on_inverted"));
@@ -451,7 +451,11 @@ void read_solver(const Context& cx, const json& v, SolverSettings& s) {
         s.linear_solver = get_enum<LinearSolver>(cx, *x, join(p, "linear"), {{"cg", LinearSolver::CG}, {"direct", LinearSolver::Direct}});
     if (const json* x = find(v, "preconditioner"))
         s.preconditioner = get_enum<PreconditionerKind>(cx, *x, join(p, "preconditioner"),
-                                                        {{"block-jacobi", PreconditionerKind::BlockJacobi}, {"amg", PreconditionerKind::Amg}});
+                                                        {{"auto", PreconditionerKind::Auto},
+                                                         {"block-jacobi", PreconditionerKind::BlockJacobi},
+                                                         {"amg", PreconditionerKind::Amg}});
+    if (const json* x = find(v, "auto_amg_iterations"))
+        s.auto_amg_iterations = get_int(cx, *x, join(p, "auto_amg_iterations"), 1);
     if (const json* x = find(v, "amg_refresh_interval"))
         s.amg_refresh_interval = get_int(cx, *x, join(p, "amg_refresh_interval"), 0);
     if (const json* x = find(v, "cg_tolerance")) s.cg_tolerance = get_number(cx, *x, join(p, "cg_tolerance"), Range::Positive);

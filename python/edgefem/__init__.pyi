@@ -142,6 +142,7 @@ class SolverSettings:
     fail_on_unconverged: bool
     max_energy_growth: float
     preconditioner: str
+    auto_amg_iterations: int
     amg_refresh_interval: int
     def __init__(self) -> None: ...
 

@@ -233,16 +233,18 @@ def test_preconditioner_setting():
     # AMG-preconditioned CG reaches block-Jacobi's solution; a bad name is an
     # error that names the setting.
     scene = clamped_box_scene(8, 3, 3)
-    assert scene.solver.preconditioner == "block-jacobi"
+    assert scene.solver.preconditioner == "auto"
+    assert scene.solver.auto_amg_iterations == 200
     scene.dt = 4e-3
     scene.solver.cg_tolerance = 1e-11
     u = {}
-    for name in ("block-jacobi", "amg"):
+    for name in ("block-jacobi", "amg", "auto"):
         scene.solver.preconditioner = name
         sim = edgefem.Simulator(scene)
         sim.run(3)
         u[name] = np.array(sim.displacement)
     assert np.linalg.norm(u["amg"] - u["block-jacobi"]) <= 1e-8 * np.linalg.norm(u["block-jacobi"])
+    assert np.linalg.norm(u["auto"] - u["block-jacobi"]) <= 1e-8 * np.linalg.norm(u["block-jacobi"])
     with pytest.raises(edgefem.InvalidArgument, match="solver.preconditioner"):
         scene.solver.preconditioner = "ilu"
 

@@ -34,5 +34,7 @@ template <class S>
 std::unique_ptr<Preconditioner<S>> make_block_jacobi(const SimState<S>& state);  // block_jacobi.cpp
 template <class S>
 std::unique_ptr<Preconditioner<S>> make_amg(const SimState<S>& state);           // amg_preconditioner.cpp
+template <class S>
+std::unique_ptr<Preconditioner<S>> make_auto_preconditioner(const SimState<S>& state);  // auto_preconditioner.cpp
 
 }  // namespace edgefem::sim

@@ -57,11 +57,16 @@ enum class LinearSolver {
 enum class PreconditionerKind {
     BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap, iterations grow with dt, stiffness and mesh size
     Amg,          // smoothed-aggregation multigrid on the rigid-body modes: set-up per K, few iterations
+    Auto,         // block-Jacobi, then AMG once a solve needs more than auto_amg_iterations (the default)
 };
 
 struct SolverSettings {
     LinearSolver linear_solver = LinearSolver::CG;
-    PreconditionerKind preconditioner = PreconditionerKind::BlockJacobi;
+    PreconditionerKind preconditioner = PreconditionerKind::Auto;
+    // Auto: the block-Jacobi CG iterations of one solve past which AMG takes
+    // over for the rest of the run (docs/solvers.md has the measured
+    // crossover). Never with cg_fixed_iterations, or off the host.
+    int auto_amg_iterations = 200;
     // AMG: when its Galerkin operators and smoothers follow a new K (the
     // fine level's products are always the current K's). 0 (default): lagged
     // while CG's iterations stay within 1.5x (+ 2) of those right after the
