@@ -15,7 +15,7 @@
 #
 # TSan and OpenMP: GCC's libgomp is not instrumented, and TSan cannot see
 # its barriers, so every OpenMP region looks like a race to it (a TSan run
-# of the whole suite with GCC, 2026-11-27: 40 of its 43 reports were in
+# of the whole suite with GCC, 2026-11-27: 41 of its 43 reports were in
 # OpenMP regions, ours and CHOLMOD's). The thread build therefore uses clang
 # with LLVM's libomp and its Archer tool (libarcher.so, which tells TSan
 # about OpenMP's synchronisation) when clang is installed; CHOLMOD's and
