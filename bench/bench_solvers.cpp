@@ -17,6 +17,7 @@
 //                         [--amg-smoother chebyshev|l1] [--amg-smoothing N] [--amg-coarse DOFS]
 //                         [--amg-levels N] [--amg-ratio R] [--amg-weight W] [--amg-strength S] [--no-hypre] [--quick]
 //                         [--threads N]  (the step part on the pool back-end's N threads; default serial)
+//                         [--amg-only]   (the matrix part without block-Jacobi: the largest meshes)
 // (--amg-*: AmgSettings' fields, for the step and matrix parts, to study the
 // hierarchy; unset ones keep SolverSettings' defaults)
 #include <HYPRE.h>
@@ -75,6 +76,7 @@ double median(std::vector<double> v) {
 AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
 bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
 int g_threads = 1;                          // --threads N: the step part on the pool back-end's N threads
+bool g_amg_only = false;                    // --amg-only: the matrix part without block-Jacobi (large meshes)
 
 std::string describe(const AmgSettings& a) {
     char buf[256];
@@ -390,7 +392,9 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
     for (const std::string& m : meshes)
         for (double dt : dts) {
             Scene s = named_scene(m);
-            for_solve(s, dt, PreconditionerKind::BlockJacobi);
+            // --amg-only: the 3 steps to the test state with AMG too (block-
+            // Jacobi's take tens of minutes on bunny-1m at 10 ms)
+            for_solve(s, dt, g_amg_only ? PreconditionerKind::Amg : PreconditionerKind::BlockJacobi);
             const std::vector<double> u = state_after(s, 3);
             auto op = cpu_operator_factory<double>()(s.mesh, s.materials, s.model, s.method);
             const Assembled all = assemble_at(s, *op, u, true);
@@ -447,11 +451,13 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
             Eigen::VectorXd x_bj, x_sa, x_h;
             for (int r = 0; r < rounds; ++r) {
                 auto t0 = Clock::now();
-                bj_setup();
-                setup_bj.push_back(ms_since(t0));
-                t0 = Clock::now();
-                its_bj.push_back(pcg(A, b, x_bj, 1e-6, bj_apply));
-                t_bj.push_back(ms_since(t0));
+                if (!g_amg_only) {
+                    bj_setup();
+                    setup_bj.push_back(ms_since(t0));
+                    t0 = Clock::now();
+                    its_bj.push_back(pcg(A, b, x_bj, 1e-6, bj_apply));
+                    t_bj.push_back(ms_since(t0));
+                }
                 t0 = Clock::now();
                 if (r == 0) {
                     sa.build(A, s.mesh.X, all.free, g_amg);
@@ -477,8 +483,10 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
             // refresh (its values and the projected copy are freed in between)
             const double sa_bytes = double(sa.bytes()) + 4.0 * (blocks + double(nv) + 1);
             const double refresh = refresh_sa.empty() ? NAN : median(refresh_sa);
-            std::printf("| %s | %g | block-Jacobi | %.0f | %.2f | %.2f | %.2f | %.2f |\n", m.c_str(), dt, median(its_bj),
-                        median(setup_bj), median(t_bj), median(setup_bj) + median(t_bj), 8.0 * 18 * double(nv) / k_bytes);
+            if (!g_amg_only)
+                std::printf("| %s | %g | block-Jacobi | %.0f | %.2f | %.2f | %.2f | %.2f |\n", m.c_str(), dt,
+                            median(its_bj), median(setup_bj), median(t_bj), median(setup_bj) + median(t_bj),
+                            8.0 * 18 * double(nv) / k_bytes);
             std::printf("| %s | %g | edgefem SA-AMG (%d levels; build %.1f, refresh) | %.0f | %.2f | %.2f | %.2f | %.2f |\n",
                         m.c_str(), dt, sa.levels(), setup_sa[0], median(its_sa), refresh, median(t_sa),
                         refresh + median(t_sa), sa_bytes / k_bytes);
@@ -532,6 +540,7 @@ int main(int argc, char** argv) {
         else if (a == "--amg-coarse") g_amg.max_coarse_dofs = std::max(1, std::stoi(next()));
         else if (a == "--no-hypre") g_no_hypre = true;
         else if (a == "--threads") g_threads = std::max(1, std::stoi(next()));
+        else if (a == "--amg-only") g_amg_only = true;
         else if (a == "--amg-levels") g_amg.max_levels = std::max(1, std::stoi(next()));
         else if (a == "--amg-ratio") g_amg.chebyshev_ratio = std::stod(next());
         else if (a == "--amg-weight") g_amg.prolongator_weight = std::stod(next());
