@@ -31,7 +31,7 @@ public:
     template <class T>
     void vector(const std::vector<T>& v) {
         value(std::uint64_t(v.size()));
-        bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+        if (!v.empty()) bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
     }
     // A back-end vector (copied to the host when it lives elsewhere).
     template <class T>
@@ -39,7 +39,7 @@ public:
         std::vector<T> scratch;
         const std::span<const T> h = v.read_host(scratch);
         value(std::uint64_t(h.size()));
-        bytes_.append(reinterpret_cast<const char*>(h.data()), h.size() * sizeof(T));
+        if (!h.empty()) bytes_.append(reinterpret_cast<const char*>(h.data()), h.size() * sizeof(T));
     }
     std::string& bytes() { return bytes_; }
 
@@ -70,7 +70,8 @@ public:
         if (expected != std::size_t(-1) && n != expected) fail(what, std::to_string(n) + " values, expected " + std::to_string(expected));
         if (n > (bytes_.size() - at_) / sizeof(T)) fail(what, "longer than the file");
         std::vector<T> v(n);
-        std::memcpy(v.data(), take(n * sizeof(T), what), n * sizeof(T));
+        const char* from = take(n * sizeof(T), what);
+        if (n > 0) std::memcpy(v.data(), from, n * sizeof(T));  // an empty vector's data() may be null (UBSan)
         return v;
     }
     // Into a back-end vector of its size.
