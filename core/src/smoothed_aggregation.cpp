@@ -391,13 +391,22 @@ struct SmoothedAggregation::Impl {
     // ends are multiples of 384: whole 3- and 6-dof nodes), on the executor.
     template <class Body>
     void par(Eigen::Index n, const Body& body) const {
-        if (!threaded()) return body(std::size_t(0), std::size_t(n));
-        for_blocks(*ex, std::size_t(n), body);
+        for_blocks_if_threaded(ex.get(), std::size_t(n), body);
     }
     void blocks(const Level& L, const double* v, double* y, double f, double keep) const {
         const std::size_t bs = std::size_t(L.bs);
         par(Eigen::Index(L.Minv.size() / bs), [&](std::size_t b, std::size_t e) {
             block_apply_range(L.Minv, L.bs, v, y, f, keep, b / bs, e / bs);
+        });
+    }
+
+    // L.r = b - A x.
+    template <class Product>
+    void residual(const Level& L, const double* b, const double* x, const Product& product) const {
+        double* r = L.r.data();
+        product(x, r);
+        par(L.r.size(), [&](std::size_t i0, std::size_t i1) {
+            for (std::size_t i = i0; i < i1; ++i) r[i] = b[i] - r[i];
         });
     }
 
@@ -413,19 +422,13 @@ struct SmoothedAggregation::Impl {
         const int steps = settings.smoothing_steps;
         L.r.resize(n);
         double* r = L.r.data();
-        const auto residual = [&] {
-            product(x, r);
-            par(n, [&](std::size_t i0, std::size_t i1) {
-                for (std::size_t i = i0; i < i1; ++i) r[i] = b[i] - r[i];
-            });
-        };
         if (settings.smoother == AmgSmoother::L1Jacobi) {
             for (int s = 0; s < steps; ++s) {
                 if (s == 0 && zero) {
                     blocks(L, b, x, 1.0, 0.0);
                     continue;
                 }
-                residual();
+                residual(L, b, x, product);
                 blocks(L, r, x, 1.0, 1.0);
             }
             return;
@@ -439,7 +442,7 @@ struct SmoothedAggregation::Impl {
                 std::copy(b + i0, b + i1, r + i0);
             });
         } else {
-            residual();
+            residual(L, b, x, product);
         }
         L.d.resize(n);
         L.t.resize(n);
@@ -472,21 +475,17 @@ struct SmoothedAggregation::Impl {
     // x = V-cycle(b) on level l (x overwritten).
     void cycle(std::size_t l, const double* b, double* x, const std::function<void(const double*, double*)>& fine) const {
         const Level& L = level[l];
-        const Eigen::Index n = Eigen::Index(L.Minv.size() / std::size_t(L.bs));
         if (l + 1 == level.size()) {
             coarse.solve(b, x);
             return;
         }
         const auto product = this->product(l, fine);
         smooth(L, b, x, true, product);
-        double* r = L.r.data();
-        product(x, r);
-        par(n, [&](std::size_t i0, std::size_t i1) {
-            for (std::size_t i = i0; i < i1; ++i) r[i] = b[i] - r[i];
-        });
+        residual(L, b, x, product);
+        const double* r = L.r.data();
         const Level& C = level[l + 1];
         C.b.resize(L.P.cols);
-        if (L.R.rows == L.P.cols && L.R.cols == L.P.rows && threaded())
+        if (threaded())  // R is built whenever the executor is threaded (build(), set_executor())
             par(L.R.rows, [&](std::size_t i0, std::size_t i1) { L.R.gather_times(r, C.b.data(), i0, i1); });
         else
             L.P.transpose_times(r, C.b.data());

@@ -100,16 +100,12 @@ public:
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override {
         if (lo != 0 || hi != s_.n()) throw InvalidArgument("AMG preconditioner: applies to the whole vector only");
         const auto& fr = s_.free_host;
-        const auto mask = [&](std::size_t i0, std::size_t i1, double* y) {
-            for (std::size_t i = i0; i < i1; ++i)
-                if (!fr[i]) y[i] = 0;
-        };
         amg_.apply(r, z, [&](const double* x, double* y) {
             A_->apply(x, y);
-            if (ex_ && ex_->threads() > 1)
-                for_blocks(*ex_, fr.size(), [&](std::size_t i0, std::size_t i1) { mask(i0, i1, y); });
-            else
-                mask(0, fr.size(), y);
+            for_blocks_if_threaded(ex_.get(), fr.size(), [&](std::size_t i0, std::size_t i1) {
+                for (std::size_t i = i0; i < i1; ++i)
+                    if (!fr[i]) y[i] = 0;
+            });
         });
     }
 

@@ -113,6 +113,15 @@ void for_blocks(const Executor& ex, std::size_t n, Body&& body) {
     ex.for_uniform_chunks(groups, [&](index_t g) { for_group_blocks(g, groups, n, body); });
 }
 
+// for_blocks on `ex` when it has more than one thread; else (null or one
+// thread) body(0, n) once on the calling thread, for host code whose
+// executor is optional.
+template <class Body>
+void for_blocks_if_threaded(const Executor* ex, std::size_t n, Body&& body) {
+    if (!ex || ex->threads() <= 1) return body(std::size_t(0), n);
+    for_blocks(*ex, n, body);
+}
+
 // Sum of term(i) over one block [b, e): 8 interleaved accumulators combined
 // pairwise. A single running sum waits one add latency per term (a CG dot
 // product over armadillo-7k took 12% of a semi-implicit step), 8 of them
