@@ -116,9 +116,10 @@ edgefem_status checkpoint_call(const char* fn, edgefem_sim* sim, const char* pat
 
 [[noreturn]] void invalid(std::string message) { throw CError{EDGEFEM_ERROR_INVALID_ARGUMENT, std::move(message)}; }
 
-void require_count(size_t count, size_t expected, const char* name) {
+// `name` holds `count` values where `expected` (`what`, in words) are needed.
+void require_count(size_t count, size_t expected, const char* name, const std::string& what = "3 x #V") {
     if (count != expected)
-        invalid(std::string(name) + ": count is " + std::to_string(count) + ", expected 3 x #V = " +
+        invalid(std::string(name) + ": count is " + std::to_string(count) + ", expected " + what + " = " +
                 std::to_string(expected));
 }
 
@@ -316,8 +317,7 @@ edgefem_status edgefem_scene_get_tets(const edgefem_scene* scene, int32_t* out, 
         require(scene, "scene");
         require(out, "out");
         const auto& T = scene->scene.mesh.tets;
-        if (count != T.size())
-            invalid("out: count is " + std::to_string(count) + ", expected 4 x #T = " + std::to_string(T.size()));
+        require_count(count, T.size(), "out", "4 x #T");
         std::copy(T.begin(), T.end(), out);
     });
 }
@@ -335,9 +335,7 @@ edgefem_status edgefem_scene_get_boundary(const edgefem_scene* scene, int32_t* o
         require(scene, "scene");
         require(out, "out");
         const auto tri = edgefem::boundary_surface(scene->scene.mesh).triangles;
-        if (count != 3 * tri.size())
-            invalid("out: count is " + std::to_string(count) + ", expected 3 x (boundary triangles) = " +
-                    std::to_string(3 * tri.size()));
+        require_count(count, 3 * tri.size(), "out", "3 x (boundary triangles)");
         for (std::size_t k = 0; k < tri.size(); ++k)
             for (int i = 0; i < 3; ++i) out[3 * k + i] = tri[k][i];
     });
@@ -581,8 +579,7 @@ edgefem_status edgefem_scene_get_regions(const edgefem_scene* scene, int32_t* ou
         require(scene, "scene");
         require(out, "out");
         const edgefem::Mesh& m = scene->scene.mesh;
-        if (count != std::size_t(m.num_tets()))
-            invalid("out: count is " + std::to_string(count) + ", expected #T = " + std::to_string(m.num_tets()));
+        require_count(count, std::size_t(m.num_tets()), "out", "#T");
         for (edgefem::index_t t = 0; t < m.num_tets(); ++t) out[t] = m.tet_region(t);
     });
 }
@@ -645,9 +642,7 @@ edgefem_status edgefem_scene_get_surface(const edgefem_scene* scene, int32_t tag
         require(scene, "scene");
         require(out, "out");
         const std::vector<edgefem::Triangle> tri = tagged(scene, tag);
-        if (count != 3 * tri.size())
-            invalid("out: count is " + std::to_string(count) + ", expected 3 x (triangles tagged " + std::to_string(tag) +
-                    ") = " + std::to_string(3 * tri.size()));
+        require_count(count, 3 * tri.size(), "out", "3 x (triangles tagged " + std::to_string(tag) + ")");
         for (std::size_t k = 0; k < tri.size(); ++k)
             for (int i = 0; i < 3; ++i) out[3 * k + i] = tri[k][i];
     });
@@ -946,9 +941,7 @@ edgefem_status edgefem_embedding_get_outside(const edgefem_embedding* embedding,
         require(embedding, "embedding");
         require(out, "out");
         const auto& d = embedding->embedding.outside;
-        if (count != d.size())
-            invalid("out: count is " + std::to_string(count) + ", expected the number of points " +
-                    std::to_string(d.size()));
+        require_count(count, d.size(), "out", "the number of points");
         std::copy(d.begin(), d.end(), out);
     });
 }
@@ -963,9 +956,7 @@ edgefem_status edgefem_sim_embedded_positions(const edgefem_sim* sim, const edge
         if (std::size_t(embedding->mesh.num_vertices()) != std::size_t(sim->sim.num_vertices()))
             invalid("embedding: made for a mesh of " + std::to_string(embedding->mesh.num_vertices()) +
                     " vertices, the simulation has " + std::to_string(sim->sim.num_vertices()));
-        if (count != 3 * points)
-            invalid("out: count is " + std::to_string(count) + ", expected 3 x (number of points) = " +
-                    std::to_string(3 * points));
+        require_count(count, 3 * points, "out", "3 x (number of points)");
         const auto u = mut(sim).displacement();
         edgefem::embedded_positions<double>(embedding->mesh, embedding->embedding,
                                             std::span<const double>(u.data(), u.size()), std::span<double>(out, count));
