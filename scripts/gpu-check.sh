@@ -34,8 +34,8 @@ check() {
     nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv 2>&1 | head -3
     nvcc --version 2>/dev/null | tail -1
     echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2) x $(nproc)"
-    echo "== GPU tests"
-    run_prog 300 edgefem_test_cuda_backend 2>&1 | tail -40
+    echo "== GPU tests (whole output: $tests_log)"
+    run_prog 240 edgefem_test_cuda_backend 2>&1 | tee "$tests_log" | grep -E "^\[ *(RUN|OK|FAILED|PASSED|SKIPPED) |Failure|error|beam, 1000|Expected|Which is|actual"
     echo "tests rc=${PIPESTATUS[0]}"
     echo "== GPU benchmarks"
     run_prog 150 edgefem_bench_gpu --meshes armadillo-7k,bunny-250k,bunny-1m 2>&1
@@ -43,13 +43,14 @@ check() {
     echo "== CPU sweep: semi-implicit step, 20 CG iterations, bunny-250k"
     for t in 1 2 4 8 16; do
         echo "-- threads $t"
-        run_prog 40 edgefem bench "$EDGEFEM_MESH_DIR/bunny-250k" --kernel step --cg-iters 20 --backend pool --threads "$t" --seconds 3 2>&1 \
+        run_prog 30 edgefem bench "$EDGEFEM_MESH_DIR/bunny-250k" --kernel step --cg-iters 20 --backend pool --threads "$t" --seconds 2 2>&1 \
             | grep -E "median_ms|min_ms|backend|error" || true
     done
     echo "== gpu-check done $(date -u +%FT%TZ)"
 }
 
 log=${OUT:-.}/gpu-check.log
+tests_log=${OUT:-.}/gpu-tests.log
 case "${1:-build}" in
 build)
     cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DEDGEFEM_CUDA=ON -DEDGEFEM_NATIVE=OFF >/dev/null || exit 1
@@ -73,11 +74,14 @@ pack)
     for m in box-1200 spot-2k bunny-4k armadillo-7k bunny-50k armadillo-100k bunny-250k bunny-1m; do
         for e in node ele; do [ -f "$mesh_dir/$m.$e" ] && gzip -6 -c "$mesh_dir/$m.$e" > "$B/meshes/$m.$e.gz"; done
     done
+    # Compressed, so that the bundle travels within the device tool's 64 MiB.
+    gzip -9 "$B"/bin/* "$B"/lib/*
     cp scripts/gpu-check.sh "$B/gpu-check.sh"
     cat > "$B/run.sh" <<'RUN'
 #!/bin/bash
 # Runs the GPU check from this bundle (scripts/gpu-check.sh pack).
 B=$(cd "$(dirname "$0")" && pwd)
+gunzip -f "$B"/bin/*.gz "$B"/lib/*.gz 2>/dev/null
 (cd "$B/meshes" && for f in *.gz; do [ -f "$f" ] && { [ -f "${f%.gz}" ] || gunzip -kf "$f"; }; done)
 export EDGEFEM_MESH_DIR=$B/meshes
 # The driver's libcuda from the machine, everything else from the bundle.
