@@ -13,11 +13,12 @@ std::string cuda_unavailable_reason() {
 std::string cuda_device_description() { return ""; }
 
 template <class S>
-std::shared_ptr<const Backend<S>> make_cuda_backend() {
+std::shared_ptr<const Backend<S>> make_cuda_backend(const CudaOptions& options) {
+    validate(options);
     throw Error("the CUDA back-end cannot run: " + cuda_unavailable_reason());
 }
 
-template std::shared_ptr<const Backend<double>> make_cuda_backend<double>();
-template std::shared_ptr<const Backend<float>> make_cuda_backend<float>();
+template std::shared_ptr<const Backend<double>> make_cuda_backend<double>(const CudaOptions&);
+template std::shared_ptr<const Backend<float>> make_cuda_backend<float>(const CudaOptions&);
 
 }  // namespace edgefem

@@ -289,6 +289,48 @@ public:
     // run; the CPU back-end overrides it with its fused three-phase form.
     CgResult cg(CgSystem& A, const CgPreconditioner& M, const std::uint8_t* free_dof, const double* b, double* x,
                 std::size_t n, const CgSettings& settings, CgWork& w) const override {
+        const CgStart start = cg_start(A, M, free_dof, b, x, n, w);
+        double* r = w.r.data();
+        double* z = w.z.data();
+        double* p = w.p.data();
+        double* Ap = w.Ap.data();
+        const double* keep = w.keep.data();
+        const CgControl control(settings, start.bnorm);
+        return cg_iterations(control, start.rr, start.rz, [&](double rz) {
+            CgSums s;
+            cg_apply(A, p, Ap, n);
+            s.pAp = launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) { return p[i] * Ap[i] * keep[i]; });
+            if (!CgControl::positive_curvature(s.pAp)) return s;
+            const double alpha = CgControl::alpha(rz, s.pAp);
+            s.rr = launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
+                x[i] += alpha * p[i];
+                r[i] = (r[i] - alpha * Ap[i]) * keep[i];
+                return r[i] * r[i];
+            });
+            M.apply(0, n, r, z);
+            s.rz = launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) { return r[i] * z[i] * keep[i]; });
+            if (control.converged(control.residual(s.rr))) return s;
+            const double beta = CgControl::beta(s.rz, rz);
+            launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { p[i] = (z[i] + beta * p[i]) * keep[i]; });
+            return s;
+        });
+    }
+
+    // The helpers below are public only because nvcc's extended lambdas
+    // may not sit in a private or protected member function.
+
+    // out = A in, both parts.
+    static void cg_apply(CgSystem& A, const double* in, double* out, std::size_t n) {
+        A.products(in, out);
+        A.finish(0, n, in, out);
+    }
+    // CG's start pass: r = P(b - A x), z = M^-1 r, p = z; the norm the
+    // residuals are relative to, r.r and r.z.
+    struct CgStart {
+        double bnorm = 0, rr = 0, rz = 0;
+    };
+    CgStart cg_start(CgSystem& A, const CgPreconditioner& M, const std::uint8_t* free_dof, const double* b, double* x,
+                     std::size_t n, CgWork& w) const {
         w.r.resize(n);
         w.z.resize(n);
         w.p.resize(n);
@@ -299,10 +341,7 @@ public:
         double* p = w.p.data();
         double* Ap = w.Ap.data();
         double* keep = w.keep.data();
-        const auto apply_A = [&](const double* in, double* out) {
-            A.products(in, out);
-            A.finish(0, n, in, out);
-        };
+        const auto apply_A = [&](const double* in, double* out) { cg_apply(A, in, out, n); };
 
         // As conjugate_gradient (cg.hpp): residuals relative to |P(b - A x_c)|.
         const bool moving = launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
@@ -330,29 +369,8 @@ public:
             p[i] = z[i] * keep[i];
             return r[i] * p[i];
         });
-        const CgControl control(settings, bnorm);
-        return cg_iterations(control, rr0, rz0, [&](double rz) {
-            CgSums s;
-            apply_A(p, Ap);
-            s.pAp = launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) { return p[i] * Ap[i] * keep[i]; });
-            if (!CgControl::positive_curvature(s.pAp)) return s;
-            const double alpha = CgControl::alpha(rz, s.pAp);
-            s.rr = launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
-                x[i] += alpha * p[i];
-                r[i] = (r[i] - alpha * Ap[i]) * keep[i];
-                return r[i] * r[i];
-            });
-            M.apply(0, n, r, z);
-            s.rz = launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) { return r[i] * z[i] * keep[i]; });
-            if (control.converged(control.residual(s.rr))) return s;
-            const double beta = CgControl::beta(s.rz, rz);
-            launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { p[i] = (z[i] + beta * p[i]) * keep[i]; });
-            return s;
-        });
+        return {bnorm, rr0, rz0};
     }
-
-    // The helpers below are public only because nvcc's extended lambdas
-    // may not sit in a private or protected member function.
     template <class T>
     void copy_any(T* dst, const T* src, std::size_t n) const {
         launch_.blocks(n, [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {

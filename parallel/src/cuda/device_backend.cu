@@ -39,6 +39,7 @@ namespace {
 template <class S>
 class DeviceBackend final : public Backend<S> {
 public:
+    explicit DeviceBackend(const CudaOptions& options) : options_(options) {}
     const char* name() const override { return "cuda"; }
     int threads() const override { return 1; }
     std::unique_ptr<ElasticOperator<S>> make_operator(const Mesh& mesh, const Materials& materials, ModelKind model,
@@ -48,12 +49,13 @@ public:
                 throw InvalidArgument("the spring-network model exists only for the edge method");
             return cuda::make_device_tet_operator<S>(mesh, materials);
         }
-        return cuda::make_device_edge_operator<S>(mesh, materials, model);
+        return cuda::make_device_edge_operator<S>(mesh, materials, model, options_.multiply_lanes);
     }
     const VectorKernels<S>& kernels() const override { return kernels_; }
     const VectorMemory& memory() const override { return memory_; }
 
 private:
+    CudaOptions options_;
     cuda::DeviceMemory memory_;
     cuda::DeviceVectorKernels<S> kernels_;
 };
@@ -61,13 +63,14 @@ private:
 }  // namespace
 
 template <class S>
-std::shared_ptr<const Backend<S>> make_cuda_backend() {
+std::shared_ptr<const Backend<S>> make_cuda_backend(const CudaOptions& options) {
+    validate(options);
     const std::string why = cuda_unavailable_reason();
     if (!why.empty()) throw Error("the CUDA back-end cannot run: " + why);
-    return std::make_shared<DeviceBackend<S>>();
+    return std::make_shared<DeviceBackend<S>>(options);
 }
 
-template std::shared_ptr<const Backend<double>> make_cuda_backend<double>();
-template std::shared_ptr<const Backend<float>> make_cuda_backend<float>();
+template std::shared_ptr<const Backend<double>> make_cuda_backend<double>(const CudaOptions&);
+template std::shared_ptr<const Backend<float>> make_cuda_backend<float>(const CudaOptions&);
 
 }  // namespace edgefem

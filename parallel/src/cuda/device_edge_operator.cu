@@ -5,6 +5,7 @@
 // stiffness pass pulls into each edge's block the TSEP blocks that target
 // it. Every term is a formula of edgefem/physics/.
 #include <algorithm>
+#include <string>
 
 #include "cuda/device_operators.cuh"
 #include "edgefem/core/coefficients.hpp"
@@ -109,6 +110,39 @@ struct DeviceEdgeModel {
     }
 };
 
+// y = K x as a gather: L threads per vertex (consecutive lanes of one warp)
+// each pull every L-th of its incident edges' terms, then the L partial sums
+// are added in a fixed shuffle order. Every thread of the grid reaches the
+// shuffles (those past the last vertex with zeros).
+template <int L, class S>
+__global__ void edge_multiply_kernel(index_t nv, const index_t* __restrict__ first, const index_t* __restrict__ inc,
+                                     const index_t* __restrict__ edge, const S* __restrict__ K,
+                                     const S* __restrict__ x, S* __restrict__ y) {
+    const std::size_t t = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+    const std::size_t v = t / L;
+    const int lane = int(t % L);
+    S acc[3] = {0, 0, 0};
+    if (v < std::size_t(nv))
+        for (index_t j = first[v] + lane; j < first[v + 1]; j += L) {
+            const std::size_t e = std::size_t(inc[j] >> 1);
+            const bool second = inc[j] & 1;
+            const std::size_t a = std::size_t(edge[2 * e]), b = std::size_t(edge[2 * e + 1]);
+            const S* k = &K[9 * e];
+            const S d0 = x[3 * a] - x[3 * b], d1 = x[3 * a + 1] - x[3 * b + 1], d2 = x[3 * a + 2] - x[3 * b + 2];
+            for (int i = 0; i < 3; ++i) {
+                if (second)
+                    acc[i] += physics::transpose_times(k[i], k[3 + i], k[6 + i], d0, d1, d2);
+                else
+                    acc[i] -= physics::row_times(k[3 * i], k[3 * i + 1], k[3 * i + 2], d0, d1, d2);
+            }
+        }
+    if constexpr (L > 1)
+        for (int off = L / 2; off > 0; off /= 2)
+            for (int i = 0; i < 3; ++i) acc[i] += __shfl_down_sync(0xffffffffu, acc[i], off, L);
+    if (lane == 0 && v < std::size_t(nv))
+        for (int i = 0; i < 3; ++i) y[3 * v + i] = acc[i];
+}
+
 // p~, zeta and g (double) of one evaluation, and the energy terms.
 template <class S>
 struct DeviceEdgeState {
@@ -125,8 +159,8 @@ struct DeviceEdgeState {
 template <class S, ModelKind Kind>
 class DeviceEdgeOperator final : public ElasticOperator<S> {
 public:
-    DeviceEdgeOperator(const Mesh& mesh, const Materials& materials)
-        : tets_(mesh), m_(model(mesh, materials), Kind == ModelKind::FE) {
+    DeviceEdgeOperator(const Mesh& mesh, const Materials& materials, int lanes)
+        : lanes_(lanes), tets_(mesh), m_(model(mesh, materials), Kind == ModelKind::FE) {
         state_.resize(m_.ne);
         K_.resize(9 * std::size_t(m_.ne));
     }
@@ -149,37 +183,55 @@ public:
         S* K = K_.data();
         // (SN: no TSEP lists, first is null.)
         launch_.each(std::size_t(m_.ne), [=] __device__(std::size_t e) {
-            S* k = &K[9 * e];
+            // Summed in registers, written once (through K itself, every
+            // term was a load and a store the compiler could not reorder:
+            // 5.9 ms for bunny-1m on an H100).
+            S k[9];
             physics::edge_stiffness(LE[e], S(physics::stiffness_g(g[e], definite)), &p[3 * e], k);
-            if (edge_first == nullptr) return;
-            for (index_t s = edge_first[e]; s < edge_first[e + 1]; ++s) {
-                const index_t P = src[s] >> 2, slot = src[s] & 3;
-                const index_t t = target[4 * std::size_t(P) + slot];
-                const S* ends[2] = {&p[3 * std::size_t(e0[P])], &p[3 * std::size_t(e1[P])]};
-                physics::add_pair_block(physics::slot_coefficient(physics::pair_coefficient(LP[P]), int(slot)),
-                                        ends[t & 1], ends[(t & 1) ^ 1], k);
-            }
+            if (edge_first != nullptr)
+                for (index_t s = edge_first[e]; s < edge_first[e + 1]; ++s) {
+                    const index_t P = src[s] >> 2, slot = src[s] & 3;
+                    const index_t t = target[4 * std::size_t(P) + slot];
+                    const S* ends[2] = {&p[3 * std::size_t(e0[P])], &p[3 * std::size_t(e1[P])]};
+                    physics::add_pair_block(physics::slot_coefficient(physics::pair_coefficient(LP[P]), int(slot)),
+                                            ends[t & 1], ends[(t & 1) ^ 1], k);
+                }
+            for (int i = 0; i < 9; ++i) K[9 * e + i] = k[i];
         });
     }
     void multiply(const S* x, S* y) const override {
+        const int lanes = lanes_;
         const index_t *first = m_.v_first.data(), *inc = m_.v_entry.data(), *edge = m_.edge.data();
         const S* K = K_.data();
-        launch_.each(std::size_t(m_.nv), [=] __device__(std::size_t v) {
-            S acc[3] = {0, 0, 0};
-            for (index_t j = first[v]; j < first[v + 1]; ++j) {
-                const std::size_t e = std::size_t(inc[j] >> 1);
-                const bool second = inc[j] & 1;
-                const std::size_t a = std::size_t(edge[2 * e]), b = std::size_t(edge[2 * e + 1]);
-                const S* k = &K[9 * e];
-                const S d0 = x[3 * a] - x[3 * b], d1 = x[3 * a + 1] - x[3 * b + 1], d2 = x[3 * a + 2] - x[3 * b + 2];
-                for (int i = 0; i < 3; ++i) {
-                    if (second)
-                        acc[i] += physics::transpose_times(k[i], k[3 + i], k[6 + i], d0, d1, d2);
-                    else
-                        acc[i] -= physics::row_times(k[3 * i], k[3 * i + 1], k[3 * i + 2], d0, d1, d2);
-                }
+        if (lanes == 0) {
+            multiply_atomic(x, y);
+            return;
+        }
+        const std::size_t threads = std::size_t(m_.nv) * std::size_t(lanes);
+        const unsigned blocks = unsigned((threads + kThreads - 1) / kThreads);
+        if (blocks == 0) return;
+        if (lanes == 8)
+            edge_multiply_kernel<8><<<blocks, kThreads>>>(m_.nv, first, inc, edge, K, x, y);
+        else if (lanes == 4)
+            edge_multiply_kernel<4><<<blocks, kThreads>>>(m_.nv, first, inc, edge, K, x, y);
+        else
+            edge_multiply_kernel<1><<<blocks, kThreads>>>(m_.nv, first, inc, edge, K, x, y);
+        check_launch("edge_multiply_kernel");
+    }
+    // One thread per edge, adding its two terms into y with atomics: the
+    // sums' order, and so their last bits, change from run to run.
+    void multiply_atomic(const S* x, S* y) const {
+        const index_t* edge = m_.edge.data();
+        const S* K = K_.data();
+        check(cudaMemsetAsync(y, 0, 3 * std::size_t(m_.nv) * sizeof(S)), "cudaMemsetAsync");
+        launch_.each(std::size_t(m_.ne), [=] __device__(std::size_t e) {
+            const std::size_t a = std::size_t(edge[2 * e]), b = std::size_t(edge[2 * e + 1]);
+            const S* k = &K[9 * e];
+            const S d0 = x[3 * a] - x[3 * b], d1 = x[3 * a + 1] - x[3 * b + 1], d2 = x[3 * a + 2] - x[3 * b + 2];
+            for (int i = 0; i < 3; ++i) {
+                atomicAdd(&y[3 * a + i], -physics::row_times(k[3 * i], k[3 * i + 1], k[3 * i + 2], d0, d1, d2));
+                atomicAdd(&y[3 * b + i], physics::transpose_times(k[i], k[3 + i], k[6 + i], d0, d1, d2));
             }
-            for (int i = 0; i < 3; ++i) y[3 * v + i] = acc[i];
         });
     }
     void diagonal_blocks(S* D) const override {
@@ -257,6 +309,7 @@ public:
     }
 
 private:
+    int lanes_;  // CudaOptions::multiply_lanes
     DeviceLaunch launch_;
     DeviceTets tets_;
     DeviceEdgeModel<S> m_;
@@ -272,14 +325,14 @@ using edge_detail::DeviceEdgeOperator;
 
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_device_edge_operator(const Mesh& mesh, const Materials& materials,
-                                                              ModelKind model) {
-    if (model == ModelKind::SN) return std::make_unique<DeviceEdgeOperator<S, ModelKind::SN>>(mesh, materials);
-    return std::make_unique<DeviceEdgeOperator<S, ModelKind::FE>>(mesh, materials);
+                                                              ModelKind model, int lanes) {
+    if (model == ModelKind::SN) return std::make_unique<DeviceEdgeOperator<S, ModelKind::SN>>(mesh, materials, lanes);
+    return std::make_unique<DeviceEdgeOperator<S, ModelKind::FE>>(mesh, materials, lanes);
 }
 
 template std::unique_ptr<ElasticOperator<double>> make_device_edge_operator<double>(const Mesh&, const Materials&,
-                                                                                   ModelKind);
+                                                                                   ModelKind, int);
 template std::unique_ptr<ElasticOperator<float>> make_device_edge_operator<float>(const Mesh&, const Materials&,
-                                                                                 ModelKind);
+                                                                                 ModelKind, int);
 
 }  // namespace edgefem::cuda

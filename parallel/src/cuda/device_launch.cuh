@@ -46,6 +46,17 @@ __global__ void sum_kernel(std::size_t n, Term term, double* partial) {
 
 __global__ void sum_partials_kernel(int n, const double* partial, double* out);
 
+// sum_partials_kernel's sum, handed to finish(total) on the device (thread 0).
+template <class Finish>
+__global__ void sum_partials_then_kernel(int n, const double* partial, Finish finish) {
+    __shared__ double shared[kThreads];
+    __shared__ double total;
+    double s = 0;
+    for (int i = threadIdx.x; i < n; i += kThreads) s += partial[i];
+    block_tree(shared, s, &total);
+    if (threadIdx.x == 0) finish(total);
+}
+
 // Generic reductions: chunks of kReduceChunk items (whole vertices), one
 // thread each, then groups of kCombineGroup partials combined in order,
 // level by level.
@@ -102,8 +113,7 @@ struct DeviceLaunch {
     template <class Term>
     double sum(std::size_t n, Term term) const {
         if (n == 0) return 0;
-        const std::size_t per_block = std::size_t(kThreads) * 4;
-        const int blocks = int((n + per_block - 1) / per_block < kSumBlocks ? (n + per_block - 1) / per_block : kSumBlocks);
+        const int blocks = sum_blocks(n);
         double* partial = static_cast<double*>(scratch->get((blocks + 1) * sizeof(double)));
         sum_kernel<<<blocks, kThreads>>>(n, term, partial);
         check_launch("sum_kernel");
@@ -112,6 +122,21 @@ struct DeviceLaunch {
         double s = 0;
         check(cudaMemcpy(&s, partial + blocks, sizeof(double), cudaMemcpyDeviceToHost), "cudaMemcpy (sum)");
         return s;
+    }
+    // sum's total (the same bits), left on the device: finish(total) runs
+    // there, on one thread, after the sum; nothing waits for it here.
+    template <class Term, class Finish>
+    void sum_then(std::size_t n, Term term, Finish finish) const {
+        const int blocks = n == 0 ? 1 : sum_blocks(n);
+        double* partial = static_cast<double*>(scratch->get(blocks * sizeof(double)));
+        sum_kernel<<<blocks, kThreads>>>(n, term, partial);
+        check_launch("sum_kernel");
+        sum_partials_then_kernel<<<1, kThreads>>>(blocks, partial, finish);
+        check_launch("sum_partials_then_kernel");
+    }
+    static int sum_blocks(std::size_t n) {
+        const std::size_t per_block = std::size_t(kThreads) * 4;
+        return int((n + per_block - 1) / per_block < kSumBlocks ? (n + per_block - 1) / per_block : kSumBlocks);
     }
     template <class Term>
     EDGEFEM_HOST_DEVICE static double range_sum(std::size_t lo, std::size_t hi, Term&& term) {

@@ -22,9 +22,10 @@ struct DeviceTets {
     DeviceArray<index_t> tets;
 };
 
+// `lanes`: CudaOptions::multiply_lanes.
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_device_edge_operator(const Mesh& mesh, const Materials& materials,
-                                                              ModelKind model);  // device_edge_operator.cu
+                                                              ModelKind model, int lanes);  // device_edge_operator.cu
 template <class S>
 std::unique_ptr<ElasticOperator<S>> make_device_tet_operator(const Mesh& mesh,
                                                              const Materials& materials);  // device_tet_operator.cu

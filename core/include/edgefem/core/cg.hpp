@@ -16,6 +16,7 @@
 
 #include "edgefem/core/backend_vector.hpp"
 #include "edgefem/core/executor.hpp"
+#include "edgefem/physics/host_device.hpp"
 
 namespace edgefem {
 
@@ -71,14 +72,16 @@ public:
 class CgControl {
 public:
     CgControl(const CgSettings& settings, double bnorm) : s_(settings), scale_(bnorm > 0 ? bnorm : 1.0) {}
-    double residual(double rr) const { return std::sqrt(rr) / scale_; }
+    double residual(double rr) const { return relative(rr, scale_); }
+    double scale() const { return scale_; }
+    EDGEFEM_HOST_DEVICE static double relative(double rr, double scale) { return std::sqrt(rr) / scale; }
     bool converged(double residual) const { return s_.fixed_iterations == 0 && residual <= s_.tolerance; }
     int limit() const { return s_.fixed_iterations > 0 ? s_.fixed_iterations : s_.max_iterations; }
     double tolerance() const { return s_.tolerance; }
     // False for p.Ap <= 0 and NaN: x stays at the last good iterate.
-    static bool positive_curvature(double pAp) { return pAp > 0; }
-    static double alpha(double rz, double pAp) { return rz / pAp; }
-    static double beta(double rz_new, double rz) { return rz_new / rz; }
+    EDGEFEM_HOST_DEVICE static bool positive_curvature(double pAp) { return pAp > 0; }
+    EDGEFEM_HOST_DEVICE static double alpha(double rz, double pAp) { return rz / pAp; }
+    EDGEFEM_HOST_DEVICE static double beta(double rz_new, double rz) { return rz_new / rz; }
 
 private:
     CgSettings s_;

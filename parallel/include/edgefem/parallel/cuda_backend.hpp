@@ -13,6 +13,7 @@
 #include <string>
 
 #include "edgefem/core/backend.hpp"
+#include "edgefem/core/error.hpp"
 
 namespace edgefem {
 
@@ -25,9 +26,26 @@ std::string cuda_unavailable_reason();
 // unavailable.
 std::string cuda_device_description();
 
+// How the back-end runs what has more than one form.
+struct CudaOptions {
+    // The edge operators' K x: `multiply_lanes` threads per vertex (1, 4 or
+    // 8) pull the terms of its edges, summed in a fixed order (the same bits
+    // on every run); 0: one thread per edge adds its terms into the result
+    // with floating-point atomics (the last bits change from run to run).
+    // Measured in docs/gpu.md.
+    int multiply_lanes = 8;
+};
+
+// Throws InvalidArgument naming the option that is out of range.
+inline void validate(const CudaOptions& o) {
+    const int l = o.multiply_lanes;
+    if (l != 0 && l != 1 && l != 4 && l != 8)
+        throw InvalidArgument("CudaOptions::multiply_lanes is " + std::to_string(l) + ", expected 0, 1, 4 or 8");
+}
+
 // The back-end on the current CUDA device. Throws Error naming the reason
-// when it cannot run.
+// when it cannot run, InvalidArgument for options out of range.
 template <class S>
-std::shared_ptr<const Backend<S>> make_cuda_backend();
+std::shared_ptr<const Backend<S>> make_cuda_backend(const CudaOptions& options = {});
 
 }  // namespace edgefem
