@@ -35,11 +35,16 @@ check() {
     nvcc --version 2>/dev/null | tail -1
     echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2) x $(nproc)"
     echo "== GPU tests (whole output: $tests_log)"
-    run_prog 300 edgefem_test_cuda_backend 2>&1 | tee "$tests_log" | grep -E "^\[ *(RUN|OK|FAILED|PASSED|SKIPPED) |Failure|error|beam, 1000|Expected|Which is|actual"
+    run_prog 200 edgefem_test_cuda_backend 2>&1 | tee "$tests_log" | grep -E "^\[ *(RUN|OK|FAILED|PASSED|SKIPPED) |Failure|error|beam, 1000|Expected|Which is|actual"
     echo "tests rc=${PIPESTATUS[0]}"
     echo "== GPU benchmarks"
-    run_prog 150 edgefem_bench_gpu --meshes armadillo-7k,bunny-250k,bunny-1m 2>&1
+    run_prog 100 edgefem_bench_gpu --meshes armadillo-7k,bunny-250k,bunny-1m 2>&1
     echo "bench rc=$?"
+    echo "== CLI: the built-in beam, 300 steps, on the GPU and on every CPU core"
+    for b in cuda auto; do
+        echo "-- --backend $b"
+        run_prog 60 edgefem simulate --backend "$b" --steps 300 --quiet --out "${TMPDIR:-/tmp}/edgefem-gpu-check-$b" 2>&1 | tail -12
+    done
     echo "== CPU sweep: semi-implicit step, 20 CG iterations, bunny-250k"
     for t in 1 2 4 8 16; do
         echo "-- threads $t"

@@ -143,6 +143,43 @@ __global__ void edge_multiply_kernel(index_t nv, const index_t* __restrict__ fir
         for (int i = 0; i < 3; ++i) y[3 * v + i] = acc[i];
 }
 
+// Each edge's K block: its own term and the TSEP blocks that target it
+// (first/src: the stiffness gather lists; null for SN). L threads per edge
+// (consecutive lanes of one warp): lane 0 starts from the own term, each
+// lane adds every L-th TSEP block in registers, then the L partial blocks
+// are added in a fixed shuffle order. (One thread per edge, summing
+// through K in memory, took 5.9 ms for bunny-1m on an H100; in registers
+// 2.0 ms; on 8 lanes: docs/gpu.md.)
+inline constexpr int kStiffnessLanes = 8;
+
+template <int L, class S>
+__global__ void edge_stiffness_kernel(index_t ne, const index_t* __restrict__ first, const index_t* __restrict__ src,
+                                      const index_t* __restrict__ e0, const index_t* __restrict__ e1,
+                                      const index_t* __restrict__ target, const S* __restrict__ LE,
+                                      const S* __restrict__ LP, const S* __restrict__ p,
+                                      const double* __restrict__ g, bool definite, S* __restrict__ K) {
+    const std::size_t t = blockIdx.x * std::size_t(blockDim.x) + threadIdx.x;
+    const std::size_t e = t / L;
+    const int lane = int(t % L);
+    S k[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    if (e < std::size_t(ne)) {
+        if (lane == 0) physics::edge_stiffness(LE[e], S(physics::stiffness_g(g[e], definite)), &p[3 * e], k);
+        if (first != nullptr)
+            for (index_t s = first[e] + lane; s < first[e + 1]; s += L) {
+                const index_t P = src[s] >> 2, slot = src[s] & 3;
+                const index_t tg = target[4 * std::size_t(P) + slot];
+                const S* ends[2] = {&p[3 * std::size_t(e0[P])], &p[3 * std::size_t(e1[P])]};
+                physics::add_pair_block(physics::slot_coefficient(physics::pair_coefficient(LP[P]), int(slot)),
+                                        ends[tg & 1], ends[(tg & 1) ^ 1], k);
+            }
+    }
+    if constexpr (L > 1)
+        for (int off = L / 2; off > 0; off /= 2)
+            for (int i = 0; i < 9; ++i) k[i] += __shfl_down_sync(0xffffffffu, k[i], off, L);
+    if (lane == 0 && e < std::size_t(ne))
+        for (int i = 0; i < 9; ++i) K[9 * e + i] = k[i];
+}
+
 // p~, zeta and g (double) of one evaluation, and the energy terms.
 template <class S>
 struct DeviceEdgeState {
@@ -176,28 +213,13 @@ public:
     }
     void build_stiffness(bool definite) override {
         if (!evaluated_) throw Error("build_stiffness: forces() has not been called");
-        const index_t *edge_first = m_.k_first.data(), *src = m_.k_entry.data(), *e0 = m_.pair_e0.data(),
-                      *e1 = m_.pair_e1.data(), *target = m_.target.data();
-        const S *LE = m_.LE.data(), *LP = m_.LP.data(), *p = state_.p.data();
-        const double* g = state_.g.data();
-        S* K = K_.data();
-        // (SN: no TSEP lists, first is null.)
-        launch_.each(std::size_t(m_.ne), [=] __device__(std::size_t e) {
-            // Summed in registers, written once (through K itself, every
-            // term was a load and a store the compiler could not reorder:
-            // 5.9 ms for bunny-1m on an H100).
-            S k[9];
-            physics::edge_stiffness(LE[e], S(physics::stiffness_g(g[e], definite)), &p[3 * e], k);
-            if (edge_first != nullptr)
-                for (index_t s = edge_first[e]; s < edge_first[e + 1]; ++s) {
-                    const index_t P = src[s] >> 2, slot = src[s] & 3;
-                    const index_t t = target[4 * std::size_t(P) + slot];
-                    const S* ends[2] = {&p[3 * std::size_t(e0[P])], &p[3 * std::size_t(e1[P])]};
-                    physics::add_pair_block(physics::slot_coefficient(physics::pair_coefficient(LP[P]), int(slot)),
-                                            ends[t & 1], ends[(t & 1) ^ 1], k);
-                }
-            for (int i = 0; i < 9; ++i) K[9 * e + i] = k[i];
-        });
+        const unsigned blocks = unsigned((std::size_t(m_.ne) * kStiffnessLanes + kThreads - 1) / kThreads);
+        if (blocks == 0) return;
+        // (SN: no TSEP lists, their pointers are null.)
+        edge_stiffness_kernel<kStiffnessLanes><<<blocks, kThreads>>>(
+            m_.ne, m_.k_first.data(), m_.k_entry.data(), m_.pair_e0.data(), m_.pair_e1.data(), m_.target.data(),
+            m_.LE.data(), m_.LP.data(), state_.p.data(), state_.g.data(), definite, K_.data());
+        check_launch("edge_stiffness_kernel");
     }
     void multiply(const S* x, S* y) const override {
         const int lanes = lanes_;

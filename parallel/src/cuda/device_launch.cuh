@@ -20,8 +20,9 @@ __global__ void each_kernel(std::size_t n, Body body) {
 
 // Sum reductions: a fixed number of blocks (kSumBlocks, fewer for short
 // vectors: a function of n), each thread summing its items in index order,
-// then a fixed tree in shared memory; a second pass sums the blocks'
-// partials the same way.
+// then a fixed tree in shared memory; the last block to finish (an integer
+// counter) then sums the blocks' partials the same way, in block order. One
+// launch; the order of every addition is fixed by n.
 inline constexpr int kSumBlocks = 1024;
 
 template <class T>
@@ -35,26 +36,33 @@ __device__ void block_tree(T* shared, T value, T* out) {
     if (threadIdx.x == 0) *out = shared[0];
 }
 
-template <class Term>
-__global__ void sum_kernel(std::size_t n, Term term, double* partial) {
+// The sum of term(i) over [0, n), left in partial[gridDim.x] and handed to
+// finish(total) on thread 0 of the last block. `done` is 0 on entry and
+// again on exit.
+template <class Term, class Finish>
+__global__ void sum_kernel(std::size_t n, Term term, double* partial, unsigned* done, Finish finish) {
     __shared__ double shared[kThreads];
+    __shared__ double total;
+    __shared__ bool last;
     double s = 0;
     for (std::size_t i = blockIdx.x * std::size_t(kThreads) + threadIdx.x; i < n; i += std::size_t(gridDim.x) * kThreads)
         s += term(i);
     block_tree(shared, s, &partial[blockIdx.x]);
-}
-
-__global__ void sum_partials_kernel(int n, const double* partial, double* out);
-
-// sum_partials_kernel's sum, handed to finish(total) on the device (thread 0).
-template <class Finish>
-__global__ void sum_partials_then_kernel(int n, const double* partial, Finish finish) {
-    __shared__ double shared[kThreads];
-    __shared__ double total;
-    double s = 0;
-    for (int i = threadIdx.x; i < n; i += kThreads) s += partial[i];
+    if (threadIdx.x == 0) {
+        __threadfence();  // this block's partial is visible before it counts itself done
+        last = atomicAdd(done, 1u) == gridDim.x - 1;
+    }
+    __syncthreads();
+    if (!last) return;
+    __threadfence();
+    s = 0;
+    for (int i = threadIdx.x; i < int(gridDim.x); i += kThreads) s += __ldcg(&partial[i]);
     block_tree(shared, s, &total);
-    if (threadIdx.x == 0) finish(total);
+    if (threadIdx.x == 0) {
+        *done = 0;
+        partial[gridDim.x] = total;
+        finish(total);
+    }
 }
 
 // Generic reductions: chunks of kReduceChunk items (whole vertices), one
@@ -86,6 +94,7 @@ __global__ void combine_kernel(std::size_t count, const R* in, R* out, Combine c
 // its calls run one at a time (a Simulator's steps are sequential).
 struct ReduceScratch {
     DeviceArray<unsigned char> bytes;
+    DeviceArray<unsigned> done{1};  // sum_kernel's counter
     void* get(std::size_t n) {
         if (bytes.size() < n) bytes.resize(n);
         return bytes.data();
@@ -113,26 +122,21 @@ struct DeviceLaunch {
     template <class Term>
     double sum(std::size_t n, Term term) const {
         if (n == 0) return 0;
-        const int blocks = sum_blocks(n);
-        double* partial = static_cast<double*>(scratch->get((blocks + 1) * sizeof(double)));
-        sum_kernel<<<blocks, kThreads>>>(n, term, partial);
-        check_launch("sum_kernel");
-        sum_partials_kernel<<<1, kThreads>>>(blocks, partial, partial + blocks);
-        check_launch("sum_partials_kernel");
+        double* out = sum_then(n, term, [] __device__(double) {});
         double s = 0;
-        check(cudaMemcpy(&s, partial + blocks, sizeof(double), cudaMemcpyDeviceToHost), "cudaMemcpy (sum)");
+        check(cudaMemcpy(&s, out, sizeof(double), cudaMemcpyDeviceToHost), "cudaMemcpy (sum)");
         return s;
     }
-    // sum's total (the same bits), left on the device: finish(total) runs
-    // there, on one thread, after the sum; nothing waits for it here.
+    // sum's total (the same bits), left on the device in the slot returned
+    // (until the next reduction) and handed to finish(total) there, on one
+    // thread; nothing waits for it here.
     template <class Term, class Finish>
-    void sum_then(std::size_t n, Term term, Finish finish) const {
+    double* sum_then(std::size_t n, Term term, Finish finish) const {
         const int blocks = n == 0 ? 1 : sum_blocks(n);
-        double* partial = static_cast<double*>(scratch->get(blocks * sizeof(double)));
-        sum_kernel<<<blocks, kThreads>>>(n, term, partial);
+        double* partial = static_cast<double*>(scratch->get((blocks + 1) * sizeof(double)));
+        sum_kernel<<<blocks, kThreads>>>(n, term, partial, scratch->done.data(), finish);
         check_launch("sum_kernel");
-        sum_partials_then_kernel<<<1, kThreads>>>(blocks, partial, finish);
-        check_launch("sum_partials_then_kernel");
+        return partial + blocks;
     }
     static int sum_blocks(std::size_t n) {
         const std::size_t per_block = std::size_t(kThreads) * 4;
