@@ -2,7 +2,8 @@
 // grid-stride kernels for the element-wise loops, and reductions in an order
 // fixed by n alone (never by the device or the grid), so that every run on
 // any GPU gives the same bits. Each reduction returns its value to the host
-// (one scalar or small struct per call).
+// (one scalar or small struct per call), or leaves it on the device for a
+// device-side continuation (sum_then).
 #pragma once
 
 #include <memory>

@@ -1,6 +1,7 @@
 // The NVIDIA GPU back-end: model data, state vectors, K blocks and the
 // solvers' vectors live on the device; one step runs there without copying
-// a vector to or from the host (a scalar comes back per reduction). Scatters
+// a vector to or from the host (CG's scalars stay on the device; other
+// reductions bring one scalar back). Scatters
 // are gathers over adjacency lists and reductions run in an order fixed by
 // the problem size, so two runs on the same GPU give the same bits.
 //
