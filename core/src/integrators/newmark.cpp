@@ -23,6 +23,16 @@ public:
     NewmarkFamily(SimState<S>& state, TangentSolve<S>& solve, NewmarkCoefficients c, bool linear)
         : s_(state), c_(c), step_(state, solve, linear) {}
 
+    // Newmark: the balance holds at both ends and v' - v = T ((1 - gamma) a
+    // + gamma a'), so the step's damping impulse is -T D ((1 - gamma) v +
+    // gamma v') (with the trapezoidal rule's du = T (v + v') / 2, the exact
+    // work alpha |du|_M^2 / T). Generalized-alpha: its balance's damping
+    // force acts at (1 - alpha_f) v' + alpha_f v.
+    std::array<double, 2> damping_velocity() const override {
+        if (c_.alpha_m == 0 && c_.alpha_f == 0) return {c_.gamma, 1 - c_.gamma};
+        return {1 - c_.alpha_f, c_.alpha_f};
+    }
+
     std::optional<double> step(double T) override {
         const Scene& scene = s_.scene;
         const std::size_t n = s_.n();

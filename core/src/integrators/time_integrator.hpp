@@ -3,6 +3,7 @@
 // make_time_integrator (time_integrator.cpp).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 
@@ -24,6 +25,12 @@ public:
     // Whether its steps build K (if not, the operator need not keep the
     // state K is built from).
     virtual bool builds_stiffness() const { return true; }
+    // The weights (w_new, w_old) of the velocity v_d = w_new v' + w_old v at
+    // which a step's mass damping acts (v, v': the step's start and end
+    // velocities), for the energy guard's account of damping's work, alpha
+    // du . M v_d: v' for the Euler steps and BDF2 (their balance holds at
+    // the step's end), (v + v') / 2 for velocity Verlet's two half kicks.
+    virtual std::array<double, 2> damping_velocity() const { return {1.0, 0.0}; }
     // Its own state beyond the history (SimState::history), for a checkpoint.
     virtual void save(CheckpointWriter& /*w*/) const {}
     virtual void load(CheckpointReader& /*r*/) {}

@@ -9,18 +9,21 @@ void StepControl<S>::advance(double T, int depth) {
     // The state is saved only when a failed step may be retried (the
     // whole step's start is kept by step()).
     const bool may_retry = depth < s_.scene.solver.max_step_halvings;
-    // Depth 0 restores the step's start, which step() has just saved.
+    const bool guard = guard_.enabled();
+    // Depth 0 restores the step's start, which step() has just saved (the
+    // energy guard reads it too).
     BackendVector<S> u_save = s_.template vector<S>(0), v_save = s_.template vector<S>(0);
     History<S> history_save;
-    if (may_retry && depth > 0) {
+    if ((may_retry || guard) && depth > 0) {
         s_.copy_state(u_save, s_.u);
         s_.copy_state(v_save, s_.v);
-        s_.copy_history(history_save, s_.history);
     }
+    if (may_retry && depth > 0) s_.copy_history(history_save, s_.history);
+    const S* u0 = depth == 0 ? step_start_u_.data() : u_save.data();
+    const S* v0 = depth == 0 ? step_start_v_.data() : v_save.data();
     try {
         s_.forces_current = false;
         s_.update_load(s_.time + T / 2);
-        const bool guard = guard_.enabled();
         EnergySample start;
         bool moved = false;
         if (guard) {
@@ -31,7 +34,8 @@ void StepControl<S>::advance(double T, int depth) {
         s_.check_finite(s_.step + 1);
         // The force pass here, if the step has none at its end, is the one
         // the next step starts with.
-        if (guard) guard_.check(T, start, W_end ? *W_end : s_.forces(true), moved);
+        if (guard)
+            guard_.check(start, u0, v0, W_end ? *W_end : s_.forces(true), moved, integrator_.damping_velocity());
         s_.time += T;
     } catch (const StepFailure& failure) {
         s_.forces_current = false;

@@ -196,6 +196,13 @@ public:
             },
             AddArrays{});
     }
+    double damping_work(const S* u, const S* u0, const S* v, const S* v0, const double* mass, double w_new,
+                        double w_old, std::size_t n) const override {
+        return launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
+            return ops::damping_work_term(mass[i / 3], double(u[i]) - double(u0[i]), double(v[i]), double(v0[i]),
+                                          w_new, w_old);
+        });
+    }
     std::size_t first_non_finite(const S* u, const S* v, std::size_t n) const override {
         return launch_.reduce(
             n, n,

@@ -149,6 +149,10 @@ public:
     // {kinetic energy, -g.(M u), f_ext.u}; mass per vertex.
     virtual std::array<double, 3> energy_sums(const S* u, const S* v, const S* fext, const double* mass,
                                               const std::array<double, 3>& g, std::size_t n) const = 0;
+    // Sum over the dofs of m (u - u0) (w_new v + w_old v0) (damping_work_term),
+    // mass per vertex: mass damping's work over a step, divided by alpha.
+    virtual double damping_work(const S* u, const S* u0, const S* v, const S* v0, const double* mass, double w_new,
+                                double w_old, std::size_t n) const = 0;
     // The first i with u[i] or v[i] not finite, n if none.
     virtual std::size_t first_non_finite(const S* u, const S* v, std::size_t n) const = 0;
     virtual Scaled scaled_dot(const double* a, const double* b, std::size_t n) const = 0;

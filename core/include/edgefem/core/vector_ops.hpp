@@ -106,6 +106,14 @@ EDGEFEM_HOST_DEVICE inline double gravity_term(double m, double g0, double g1, d
     return m * (g0 * ux + g1 * uy + g2 * uz);
 }
 
+// One dof's mass-damping work over a step, divided by alpha: m du . v_d,
+// with v_d = w_new v' + w_old v the velocity the step's damping force acts
+// at (TimeIntegrator::damping_velocity).
+EDGEFEM_HOST_DEVICE inline double damping_work_term(double m, double du, double v_new, double v_old, double w_new,
+                                                    double w_old) {
+    return m * du * (w_new * v_new + w_old * v_old);
+}
+
 // Inverse of the symmetric part of B (row-major into inv) by Cholesky;
 // false when it is not positive definite. Written out for 3x3: Eigen's LLT
 // solve against the identity went through its general triangular solver
