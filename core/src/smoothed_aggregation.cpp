@@ -231,40 +231,89 @@ double largest_eigenvalue(const SparseRows& A, const std::vector<double>& Dinv, 
     return lambda;
 }
 
-// A sparse matrix kept for the V-cycle in float values and int indices
-// (row-major), half of double's 12 bytes per entry less 4: the prolongators
-// and the coarse operators. The preconditioner stays a fixed symmetric
-// operator (R = P^T reads the same rounded values; a symmetric matrix
-// rounded entrywise stays symmetric); the products accumulate in double.
-struct CompactRows {
+// A sparse matrix kept for the V-cycle as dense rb x cb blocks (a node's
+// dofs against a node's or an aggregate's modes: 3 x 6 and 6 x 6 for the
+// prolongators, 6 x 6 for the coarse operators), float values and one int
+// per block: 4.2-4.4 bytes per entry against 8 for float values with an
+// int per entry. The preconditioner stays a fixed symmetric operator (R =
+// P^T reads the same rounded values; a symmetric matrix rounded entrywise
+// stays symmetric); the products accumulate in double, each row's terms in
+// increasing column order (a block's zeros add nothing).
+struct BlockRows {
     Eigen::Index rows = 0, cols = 0;
-    std::vector<int> start, col;
-    std::vector<float> val;
+    int rb = 1, cb = 1;           // block rows and columns
+    std::vector<int> start, col;  // per block row, its blocks [start[I], start[I + 1]) and their block columns
+    std::vector<float> val;       // rb x cb per block, row-major
 
-    void assign(const SparseRows& M) {
+    void assign(const SparseRows& M, int row_block, int col_block) {
         rows = M.rows();
         cols = M.cols();
-        start.assign(std::size_t(rows) + 1, 0);
+        rb = row_block;
+        cb = col_block;
+        if (rows % rb != 0 || cols % cb != 0) throw Error("AMG: a matrix is not made of whole blocks");
+        const std::size_t nbr = std::size_t(rows / rb), w = std::size_t(rb) * std::size_t(cb);
+        start.assign(nbr + 1, 0);
         col.clear();
         val.clear();
-        col.reserve(std::size_t(M.nonZeros()));
-        val.reserve(std::size_t(M.nonZeros()));
-        for (Eigen::Index i = 0; i < rows; ++i) {
-            for (SparseRows::InnerIterator it(M, i); it; ++it)
-                if (it.value() != 0) {
-                    col.push_back(int(it.col()));
-                    val.push_back(float(it.value()));
+        std::vector<int> slot(std::size_t(cols / cb), -1);  // block column -> its block in the current row, -1 none
+        std::vector<int> here;
+        for (std::size_t I = 0; I < nbr; ++I) {
+            here.clear();
+            for (int i = 0; i < rb; ++i)
+                for (SparseRows::InnerIterator it(M, Eigen::Index(I) * rb + i); it; ++it) {
+                    const std::size_t J = std::size_t(it.col() / cb);
+                    if (it.value() != 0 && slot[J] == -1) {
+                        slot[J] = 0;
+                        here.push_back(int(J));
+                    }
                 }
-            start[std::size_t(i) + 1] = int(col.size());
+            std::sort(here.begin(), here.end());
+            for (const int J : here) {
+                slot[std::size_t(J)] = int(col.size());
+                col.push_back(J);
+            }
+            val.resize(col.size() * w, 0.0f);
+            for (int i = 0; i < rb; ++i)
+                for (SparseRows::InnerIterator it(M, Eigen::Index(I) * rb + i); it; ++it)
+                    if (it.value() != 0) {
+                        const std::size_t k = std::size_t(slot[std::size_t(it.col() / cb)]);
+                        val[(k * std::size_t(rb) + std::size_t(i)) * std::size_t(cb) + std::size_t(it.col() % cb)] =
+                            float(it.value());
+                    }
+            for (const int J : here) slot[std::size_t(J)] = -1;
+            start[I + 1] = int(col.size());
         }
     }
-    // y = M x, or y += M x with accumulate, rows [r0, r1)
-    void times(const double* x, double* y, bool accumulate, std::size_t r0, std::size_t r1) const {
-        for (Eigen::Index i = Eigen::Index(r0); i < Eigen::Index(r1); ++i) {
-            double s = 0;
-            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) s += double(val[std::size_t(k)]) * x[col[std::size_t(k)]];
-            y[i] = accumulate ? y[i] + s : s;
+    // y = M x on rows [r0, r1) (whole blocks)
+    void times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
+        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
+        double s[kModes];
+        for (std::size_t I = r0 / b; I < r1 / b; ++I) {
+            std::fill(s, s + b, 0.0);
+            for (int k = start[I]; k < start[I + 1]; ++k) {
+                const float* v = &val[std::size_t(k) * b * c];
+                const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
+                for (std::size_t i = 0; i < b; ++i)
+                    for (std::size_t j = 0; j < c; ++j) s[i] += double(v[i * c + j]) * xj[j];
+            }
+            std::copy(s, s + b, y + I * b);
         }
+    }
+    // y += M x on rows [r0, r1) (whole blocks), each y_i updated by fused
+    // multiply-adds in increasing column order: bitwise transposed()'s
+    // transpose_add(x, y).
+    void times_add(const double* x, double* y, std::size_t r0, std::size_t r1) const {
+        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
+        for (std::size_t I = r0 / b; I < r1 / b; ++I)
+            for (std::size_t i = 0; i < b; ++i) {
+                double s = y[I * b + i];
+                for (int k = start[I]; k < start[I + 1]; ++k) {
+                    const float* v = &val[(std::size_t(k) * b + i) * c];
+                    const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
+                    for (std::size_t j = 0; j < c; ++j) s = std::fma(double(v[j]), xj[j], s);
+                }
+                y[I * b + i] = s;
+            }
     }
     // y = M^T x, scattered row by row. Fused multiply-adds, spelt out:
     // gather_times on the stored transpose adds the same terms in the same
@@ -272,48 +321,71 @@ struct CompactRows {
     // its own and not the gather's sum).
     void transpose_times(const double* x, double* y) const {
         std::fill(y, y + cols, 0.0);
-        for (Eigen::Index i = 0; i < rows; ++i)
-            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) {
-                double& yc = y[col[std::size_t(k)]];
-                yc = std::fma(double(val[std::size_t(k)]), x[i], yc);
-            }
+        transpose_add(x, y);
+    }
+    // y += M^T x, the same scatter.
+    void transpose_add(const double* x, double* y) const {
+        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
+        for (std::size_t I = 0; I + 1 < start.size(); ++I)
+            for (std::size_t i = 0; i < b; ++i)
+                for (int k = start[I]; k < start[I + 1]; ++k) {
+                    const float* v = &val[(std::size_t(k) * b + i) * c];
+                    double* yj = y + std::size_t(col[std::size_t(k)]) * c;
+                    for (std::size_t j = 0; j < c; ++j) yj[j] = std::fma(double(v[j]), x[I * b + i], yj[j]);
+                }
     }
     // Rows [r0, r1) of y = M x for M = transposed() of a matrix N: bitwise
     // N.transpose_times(x, y) there.
     void gather_times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        for (std::size_t i = r0; i < r1; ++i) {
-            double s = 0;
-            for (int k = start[i]; k < start[i + 1]; ++k) s = std::fma(double(val[std::size_t(k)]), x[col[std::size_t(k)]], s);
-            y[i] = s;
-        }
+        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
+        for (std::size_t I = r0 / b; I < r1 / b; ++I)
+            for (std::size_t i = 0; i < b; ++i) {
+                double s = 0;
+                for (int k = start[I]; k < start[I + 1]; ++k) {
+                    const float* v = &val[(std::size_t(k) * b + i) * c];
+                    const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
+                    for (std::size_t j = 0; j < c; ++j) s = std::fma(double(v[j]), xj[j], s);
+                }
+                y[I * b + i] = s;
+            }
     }
-    // M^T with each row's entries in increasing column order: row j of it
-    // times x adds the terms of column j in the order transpose_times adds
-    // them (bitwise the same y).
-    CompactRows transposed() const {
-        CompactRows t;
+    // M^T with each block row's blocks in increasing block column order:
+    // its row j times x adds the terms of column j in the order
+    // transpose_times adds them (bitwise the same y).
+    BlockRows transposed() const {
+        BlockRows t;
         t.rows = cols;
         t.cols = rows;
-        t.start.assign(std::size_t(cols) + 1, 0);
-        for (int c : col) ++t.start[std::size_t(c) + 1];
-        for (std::size_t j = 0; j < std::size_t(cols); ++j) t.start[j + 1] += t.start[j];
+        t.rb = cb;
+        t.cb = rb;
+        const std::size_t nbc = std::size_t(cols / cb), w = std::size_t(rb) * std::size_t(cb);
+        t.start.assign(nbc + 1, 0);
+        for (int J : col) ++t.start[std::size_t(J) + 1];
+        for (std::size_t J = 0; J < nbc; ++J) t.start[J + 1] += t.start[J];
         t.col.resize(col.size());
         t.val.resize(val.size());
         std::vector<int> next(t.start.begin(), t.start.end() - 1);
-        for (Eigen::Index i = 0; i < rows; ++i)
-            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k) {
-                const int at = next[std::size_t(col[std::size_t(k)])]++;
-                t.col[std::size_t(at)] = int(i);
-                t.val[std::size_t(at)] = val[std::size_t(k)];
+        for (std::size_t I = 0; I + 1 < start.size(); ++I)
+            for (int k = start[I]; k < start[I + 1]; ++k) {
+                const std::size_t at = std::size_t(next[std::size_t(col[std::size_t(k)])]++);
+                t.col[at] = int(I);
+                for (int i = 0; i < rb; ++i)
+                    for (int j = 0; j < cb; ++j)
+                        t.val[at * w + std::size_t(j) * std::size_t(rb) + std::size_t(i)] =
+                            val[std::size_t(k) * w + std::size_t(i) * std::size_t(cb) + std::size_t(j)];
             }
         return t;
     }
     SparseRows expand() const {
         std::vector<Eigen::Triplet<double>> t;
         t.reserve(val.size());
-        for (Eigen::Index i = 0; i < rows; ++i)
-            for (int k = start[std::size_t(i)]; k < start[std::size_t(i) + 1]; ++k)
-                t.emplace_back(int(i), col[std::size_t(k)], double(val[std::size_t(k)]));
+        for (std::size_t I = 0; I + 1 < start.size(); ++I)
+            for (int k = start[I]; k < start[I + 1]; ++k)
+                for (int i = 0; i < rb; ++i)
+                    for (int j = 0; j < cb; ++j) {
+                        const float v = val[(std::size_t(k) * std::size_t(rb) + std::size_t(i)) * std::size_t(cb) + std::size_t(j)];
+                        if (v != 0) t.emplace_back(int(I) * rb + i, col[std::size_t(k)] * cb + j, double(v));
+                    }
         SparseRows M(rows, cols);
         M.setFromTriplets(t.begin(), t.end());
         return M;
@@ -371,9 +443,12 @@ Eigen::MatrixXd rigid_body_modes(const std::vector<double>& p) {
 struct SmoothedAggregation::Impl {
     struct Level {
         int bs = 3;
-        CompactRows A;         // level >= 1 and not the coarsest: R A P of the level above
-        CompactRows P;         // to the next level
-        CompactRows R;         // P^T, with a threaded executor only (its rows in parallel; else P's scatter)
+        BlockRows A;           // level >= 1 and not the coarsest: R A P of the level above
+        // The prolongator to the next level, held one way only: P with a
+        // serial executor, its transpose R = P^T with a threaded one (the
+        // restriction then a gather over R's rows in parallel, the
+        // prolongation a scatter from them; bitwise P's products).
+        BlockRows P, R;
         SparseRows P_tent;     // before smoothing (build only; release_build_data() frees it)
         Eigen::MatrixXd B;     // near-nullspace, dofs x 6
         std::vector<double> Minv;  // the smoother's inverse blocks (D^-1, or l1 block-Jacobi's)
@@ -387,6 +462,20 @@ struct SmoothedAggregation::Impl {
     std::shared_ptr<const Executor> ex;  // null or one thread: serial
 
     bool threaded() const { return ex && ex->threads() > 1; }
+    // Level L's prolongator as it is held (P, or R's transpose), expanded.
+    static SparseRows prolongator(const Level& L) {
+        return L.P.rows > 0 ? L.P.expand() : SparseRows(L.R.expand().transpose());
+    }
+    // Holds level L's prolongator the way the executor uses it.
+    void hold(Level& L) const {
+        if (threaded() && L.P.rows > 0) {
+            L.R = L.P.transposed();
+            L.P = BlockRows();
+        } else if (!threaded() && L.R.rows > 0) {
+            L.P = L.R.transposed();
+            L.R = BlockRows();
+        }
+    }
     // body(begin, end) over [0, n) in the fixed blocks of for_blocks (their
     // ends are multiples of 384: whole 3- and 6-dof nodes), on the executor.
     template <class Body>
@@ -468,7 +557,7 @@ struct SmoothedAggregation::Impl {
         return [this, l, &fine](const double* in, double* out) {
             const Level& L = level[l];
             if (l == 0) return fine(in, out);
-            par(L.A.rows, [&](std::size_t i0, std::size_t i1) { L.A.times(in, out, false, i0, i1); });
+            par(L.A.rows, [&](std::size_t i0, std::size_t i1) { L.A.times(in, out, i0, i1); });
         };
     }
 
@@ -484,14 +573,18 @@ struct SmoothedAggregation::Impl {
         residual(L, b, x, product);
         const double* r = L.r.data();
         const Level& C = level[l + 1];
-        C.b.resize(L.P.cols);
-        if (threaded())  // R is built whenever the executor is threaded (build(), set_executor())
+        const bool gather = L.R.rows > 0;  // threaded: R (build(), set_executor())
+        C.b.resize(gather ? L.R.rows : L.P.cols);
+        if (gather)
             par(L.R.rows, [&](std::size_t i0, std::size_t i1) { L.R.gather_times(r, C.b.data(), i0, i1); });
         else
             L.P.transpose_times(r, C.b.data());
         C.x.resize(C.b.size());
         cycle(l + 1, C.b.data(), C.x.data(), fine);
-        par(L.P.rows, [&](std::size_t i0, std::size_t i1) { L.P.times(C.x.data(), x, true, i0, i1); });
+        if (gather)
+            L.R.transpose_add(C.x.data(), x);
+        else
+            L.P.times_add(C.x.data(), x, 0, std::size_t(L.P.rows));
         smooth(L, b, x, false, product);
     }
 };
@@ -562,9 +655,9 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         const SparseRows DinvA = block_diagonal(Dinv, bs, Al.rows()) * Al;
         const double rho = largest_eigenvalue(Al, Dinv, bs, settings.power_iterations);
         const SparseRows P = L.P_tent - (settings.prolongator_weight / rho) * SparseRows(DinvA * L.P_tent);
-        L.P.assign(P);
-        if (m.threaded()) L.R = L.P.transposed();
+        L.P.assign(P, bs, kModes);
         const SparseRows Pf = L.P.expand();  // the rounded P, as refresh() and apply() use it
+        m.hold(L);
         SparseRows Ac = SparseRows(Pf.transpose()) * Al * Pf;
         m.level.emplace_back();
         m.level.back().bs = kModes;
@@ -582,13 +675,13 @@ void SmoothedAggregation::refresh(const SparseRows& A) {
     for (std::size_t l = 0; l < m.level.size(); ++l) {
         Impl::Level& L = m.level[l];
         if (l > 0) {
-            const SparseRows P = m.level[l - 1].P.expand();
+            const SparseRows P = Impl::prolongator(m.level[l - 1]);
             SparseRows next = SparseRows(P.transpose()) * (*Al * P);
             Acur = std::move(next);
             Al = &Acur;
         }
         if (l + 1 < m.level.size()) {
-            if (l > 0) L.A.assign(*Al);
+            if (l > 0) L.A.assign(*Al, L.bs, L.bs);
             const bool cheb = m.settings.smoother == AmgSmoother::Chebyshev;
             L.Minv = block_inverse(*Al, L.bs, !cheb);
             if (cheb) L.lambda = largest_eigenvalue(*Al, L.Minv, L.bs, m.settings.power_iterations);
@@ -603,7 +696,7 @@ void SmoothedAggregation::refresh(const SparseRows& A) {
 void SmoothedAggregation::set_executor(std::shared_ptr<const Executor> ex) {
     impl_->ex = std::move(ex);
     for (auto& L : impl_->level)
-        if (impl_->threaded() && L.P.rows > 0 && L.R.rows == 0) L.R = L.P.transposed();
+        impl_->hold(L);
 }
 
 void SmoothedAggregation::apply(const double* r, double* z, const std::function<void(const double*, double*)>& fine) const {
@@ -624,7 +717,7 @@ index_t SmoothedAggregation::dofs(int l) const {
     return index_t(L.Minv.size() / std::size_t(L.bs));
 }
 const SparseRows& SmoothedAggregation::tentative(int l) const { return impl_->level[std::size_t(l)].P_tent; }
-SparseRows SmoothedAggregation::prolongator(int l) const { return impl_->level[std::size_t(l)].P.expand(); }
+SparseRows SmoothedAggregation::prolongator(int l) const { return Impl::prolongator(impl_->level[std::size_t(l)]); }
 const Eigen::MatrixXd& SmoothedAggregation::near_nullspace(int l) const { return impl_->level[std::size_t(l)].B; }
 SparseRows SmoothedAggregation::matrix(int l) const { return impl_->level[std::size_t(l)].A.expand(); }
 
