@@ -3,7 +3,6 @@
 // make_time_integrator (time_integrator.cpp).
 #pragma once
 
-#include <array>
 #include <memory>
 #include <optional>
 
@@ -12,6 +11,15 @@
 #include "solvers/tangent_solve.hpp"
 
 namespace edgefem::sim {
+
+// The work of a step's mass damping, as the energy guard counts it: by
+// default 2 T alpha x the kinetic energy at the step's end (alpha T |v'|_M^2,
+// the work of alpha M v' over du = T v': exact for the Euler steps); with
+// `from_displacement`, alpha du . M v_d with v_d = w_new v' + w_old v.
+struct DampingAccount {
+    bool from_displacement = false;
+    double w_new = 1, w_old = 0;
+};
 
 template <class S>
 class TimeIntegrator {
@@ -25,12 +33,8 @@ public:
     // Whether its steps build K (if not, the operator need not keep the
     // state K is built from).
     virtual bool builds_stiffness() const { return true; }
-    // The weights (w_new, w_old) of the velocity v_d = w_new v' + w_old v at
-    // which a step's mass damping acts (v, v': the step's start and end
-    // velocities), for the energy guard's account of damping's work, alpha
-    // du . M v_d: v' for the Euler steps and BDF2 (their balance holds at
-    // the step's end), (v + v') / 2 for velocity Verlet's two half kicks.
-    virtual std::array<double, 2> damping_velocity() const { return {1.0, 0.0}; }
+    // How the energy guard counts the work of a step's mass damping.
+    virtual DampingAccount damping_account() const { return {}; }
     // Its own state beyond the history (SimState::history), for a checkpoint.
     virtual void save(CheckpointWriter& /*w*/) const {}
     virtual void load(CheckpointReader& /*r*/) {}

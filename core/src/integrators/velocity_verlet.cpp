@@ -16,7 +16,6 @@ class VelocityVerlet final : public TimeIntegrator<S> {
 public:
     explicit VelocityVerlet(SimState<S>& state) : s_(state) {}
     bool builds_stiffness() const override { return false; }
-    std::array<double, 2> damping_velocity() const override { return {0.5, 0.5}; }
 
     std::optional<double> step(double T) override {
         const std::size_t n = s_.n();

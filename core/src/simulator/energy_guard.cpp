@@ -31,21 +31,17 @@ bool EnergyGuard<S>::constraints_move(double t_end) const {
 }
 
 // The step's gain is its energy change net of the external work (f_ext is
-// constant over the step: f_ext.du) and of what mass damping removed, alpha
-// du . M v_d with v_d the velocity at which the integrator's damping force
-// acts (TimeIntegrator::damping_velocity), so it is the integrator's own
-// energy error: damping does not hide an injection. (2 T alpha x the new
-// kinetic energy, the Euler steps' account, credited the trapezoidal rule
-// with damping a mode that flips its velocity every step, which it barely
-// damps: a spurious gain of 1.6x on a kicked bar, docs/lab/2026-11-27-
-// integrators-stress.md.) Gains accumulate from their lowest
+// constant over the step: f_ext.du) and of what mass damping removed, as the
+// integrator counts it (TimeIntegrator::damping_account: 2 T alpha x the new
+// kinetic energy for the Euler steps, alpha du . M v_d for Newmark), so it
+// is the integrator's own energy error: damping does not hide an injection. Gains accumulate from their lowest
 // level (a one-sided CUSUM: dissipation is no credit for later injection)
 // and may not exceed (max_energy_growth - 1) x the largest kinetic +
 // elastic energy the body has had net of such gains, plus the sums'
 // round-off.
 template <class S>
-void EnergyGuard<S>::check(const EnergySample& start, const S* u0, const S* v0, double W_end, bool constraints_moved,
-                           const std::array<double, 2>& damping_velocity) {
+void EnergyGuard<S>::check(double T, const EnergySample& start, const S* u0, const S* v0, double W_end,
+                           bool constraints_moved, const DampingAccount& account) {
     const Scene& scene = s_.scene;
     StepStats& stats = s_.stats;
     s_.copy_state(u_evaluated_, s_.u);
@@ -61,10 +57,10 @@ void EnergyGuard<S>::check(const EnergySample& start, const S* u0, const S* v0, 
     double excess = energy_excess_;
     if (!constraints_moved) {
         const double alpha = scene.rayleigh_alpha;
-        const double damping = alpha == 0 ? 0.0
-                                          : alpha * s_.kernels.damping_work(s_.u.data(), u0, s_.v.data(), v0,
-                                                                            s_.mass.data(), damping_velocity[0],
-                                                                            damping_velocity[1], s_.n());
+        const double damping = alpha == 0 || !account.from_displacement
+                                   ? 2 * T * alpha * end.kinetic
+                                   : alpha * s_.kernels.damping_work(s_.u.data(), u0, s_.v.data(), v0, s_.mass.data(),
+                                                                     account.w_new, account.w_old, s_.n());
         const double gain = (end.total() - start.total()) - (end.load - start.load) + damping;
         const double noise = 256 * double(std::numeric_limits<S>::epsilon()) * (start.magnitude() + end.magnitude());
         excess += gain;

@@ -6,9 +6,9 @@
 // a StepFailure.
 #pragma once
 
-#include <array>
 #include <cmath>
 
+#include "integrators/time_integrator.hpp"
 #include "simulator/checkpoint_stream.hpp"
 #include "simulator/state.hpp"
 
@@ -45,11 +45,11 @@ public:
     // overwritten f, so the next start evaluates the forces again.
     void forget() { evaluated_valid_ = false; }
 
-    // After a step that started at `start` (state u0, v0) and ends with
-    // elastic energy W_end; `damping_velocity`: the integrator's
-    // (TimeIntegrator::damping_velocity).
-    void check(const EnergySample& start, const S* u0, const S* v0, double W_end, bool constraints_moved,
-               const std::array<double, 2>& damping_velocity);
+    // After a step of size T that started at `start` (state u0, v0) and
+    // ends with elastic energy W_end; `damping`: the integrator's account of
+    // mass damping's work (TimeIntegrator::damping_account).
+    void check(double T, const EnergySample& start, const S* u0, const S* v0, double W_end, bool constraints_moved,
+               const DampingAccount& damping);
 
     // For a checkpoint: the gain counted and the largest energy seen (the
     // next start evaluates the forces again).

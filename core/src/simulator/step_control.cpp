@@ -35,7 +35,7 @@ void StepControl<S>::advance(double T, int depth) {
         // The force pass here, if the step has none at its end, is the one
         // the next step starts with.
         if (guard)
-            guard_.check(start, u0, v0, W_end ? *W_end : s_.forces(true), moved, integrator_.damping_velocity());
+            guard_.check(T, start, u0, v0, W_end ? *W_end : s_.forces(true), moved, integrator_.damping_account());
         s_.time += T;
     } catch (const StepFailure& failure) {
         s_.forces_current = false;
