@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
         double* d = nullptr;
         cudaMalloc(&d, sizeof(double));
         double h = 0;
-        const double launch_us = 1e3 * median_ms(200, [] { empty_kernel<<<1, 32>>>(); }) ;
+        const double launch_us = 1e3 * median_ms(200, [] { empty_kernel<<<1, 32>>>(); });
         const double copy_us = 1e3 * median_ms(200, [&] { cudaMemcpy(&h, d, sizeof h, cudaMemcpyDeviceToHost); });
         const double queued_us = 1e3 * median_ms(20, [] { for (int k = 0; k < 100; ++k) empty_kernel<<<1, 32>>>(); }) / 100;
         cudaFree(d);

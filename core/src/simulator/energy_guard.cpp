@@ -34,8 +34,9 @@ bool EnergyGuard<S>::constraints_move(double t_end) const {
 // constant over the step: f_ext.du) and of what mass damping removed, as the
 // integrator counts it (TimeIntegrator::damping_account: 2 T alpha x the new
 // kinetic energy for the Euler steps, alpha du . M v_d for Newmark), so it
-// is the integrator's own energy error: damping does not hide an injection. Gains accumulate from their lowest
-// level (a one-sided CUSUM: dissipation is no credit for later injection)
+// is the integrator's own energy error: damping does not hide an injection.
+// Gains accumulate from their lowest level (a one-sided CUSUM: dissipation
+// is no credit for later injection)
 // and may not exceed (max_energy_growth - 1) x the largest kinetic +
 // elastic energy the body has had net of such gains, plus the sums'
 // round-off.

@@ -6,15 +6,16 @@ namespace edgefem::sim {
 
 template <class S>
 void StepControl<S>::advance(double T, int depth) {
-    // The state is saved only when a failed step may be retried (the
-    // whole step's start is kept by step()).
+    // The state is saved only when a failed step may be retried, or the
+    // energy guard counts damping from the step's displacement (the whole
+    // step's start is kept by step()).
     const bool may_retry = depth < s_.scene.solver.max_step_halvings;
     const bool guard = guard_.enabled();
     // Depth 0 restores the step's start, which step() has just saved (the
     // energy guard reads it too).
     BackendVector<S> u_save = s_.template vector<S>(0), v_save = s_.template vector<S>(0);
     History<S> history_save;
-    if ((may_retry || guard) && depth > 0) {
+    if ((may_retry || (guard && integrator_.damping_account().from_displacement)) && depth > 0) {
         s_.copy_state(u_save, s_.u);
         s_.copy_state(v_save, s_.v);
     }

@@ -10,8 +10,9 @@
 // products through a caller's function (the matrix-free per-edge K). On the
 // host: on an executor's threads when set_executor() gives one (the vector
 // passes, the smoothers' blocks, the coarse products and the transfers in
-// the fixed blocks of for_blocks; the restriction then through a stored
-// P^T), bitwise the same for any executor and thread count.
+// the fixed blocks of for_blocks; the prolongator then held as P^T, the
+// restriction a gather over its rows), bitwise the same for any executor
+// and thread count.
 #pragma once
 
 #include <Eigen/SparseCore>
@@ -37,8 +38,8 @@ public:
     // constrained dofs zero; rest: 3 coordinates per vertex; free_dof: 1 on
     // unknowns. Builds the hierarchy, then refresh(A).
     // Runs apply() and smooth() on `ex` (null: serial). With more than one
-    // thread P^T is stored as well (a gather instead of P's scatter): the
-    // prolongators' memory doubles.
+    // thread the prolongators are held transposed (P^T instead of P, the
+    // same memory): the restriction a gather, the prolongation a scatter.
     void set_executor(std::shared_ptr<const Executor> ex);
     void build(const SparseRows& A, const std::vector<double>& rest, const std::vector<std::uint8_t>& free_dof,
                const AmgSettings& settings = {});

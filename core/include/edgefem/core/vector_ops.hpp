@@ -108,7 +108,7 @@ EDGEFEM_HOST_DEVICE inline double gravity_term(double m, double g0, double g1, d
 
 // One dof's mass-damping work over a step, divided by alpha: m du . v_d,
 // with v_d = w_new v' + w_old v the velocity the step's damping force acts
-// at (TimeIntegrator::damping_velocity).
+// at (TimeIntegrator::damping_account).
 EDGEFEM_HOST_DEVICE inline double damping_work_term(double m, double du, double v_new, double v_old, double w_new,
                                                     double w_old) {
     return m * du * (w_new * v_new + w_old * v_old);
