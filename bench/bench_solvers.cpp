@@ -239,13 +239,16 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
                 "default: refreshed when the iterations grow 1.5x).\n\n",
                 ex ? ("pool x" + std::to_string(g_threads)).c_str() : "serial", rounds);
     std::printf("| mesh | dofs | dt ms | BJ its | AMG its (every K / lagged) | BJ ms/step | AMG ms/step (every K / lagged) | "
-                "lagged AMG / BJ | BJ set-up ms | AMG set-up ms (every K / lagged) | AMG first step ms |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+                "lagged AMG / BJ | direct ms/step | direct / BJ | BJ set-up ms | AMG set-up ms (every K / lagged) | "
+                "AMG first step ms |\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const std::string& m : meshes)
         for (double dt : dts) {
             Scene s = named_scene(m);
-            Scene sb = s, sa = s, sl = s;
+            Scene sb = s, sa = s, sl = s, sd = s;
             for_solve(sb, dt, PreconditionerKind::BlockJacobi);
+            for_solve(sd, dt, PreconditionerKind::BlockJacobi);
+            sd.solver.linear_solver = LinearSolver::Direct;
             for_solve(sa, dt, PreconditionerKind::Amg);
             for_solve(sl, dt, PreconditionerKind::Amg);
             sa.solver.amg_refresh_interval = 1;
@@ -253,25 +256,28 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
             Simulator<double> bj(sb, ex, cpu_operator_factory<double>());
             Simulator<double> amg(sa, ex, cpu_operator_factory<double>());
             Simulator<double> lag(sl, ex, cpu_operator_factory<double>());
+            Simulator<double> direct(sd, ex, cpu_operator_factory<double>());
             bj.step();
             lag.step();
+            direct.step();
             auto t0 = Clock::now();
             amg.step();
             const double first = ms_since(t0);
-            std::vector<double> ms[3], its[3], setup[3];
+            std::vector<double> ms[4], its[4], setup[4];
             for (int r = 0; r < rounds; ++r)
-                for (int k = 0; k < 3; ++k) {
-                    Simulator<double>& sim = k == 0 ? bj : k == 1 ? amg : lag;
+                for (int k = 0; k < 4; ++k) {
+                    Simulator<double>& sim = k == 0 ? bj : k == 1 ? amg : k == 2 ? lag : direct;
                     t0 = Clock::now();
                     const StepStats& st = sim.step();
                     ms[k].push_back(ms_since(t0));
                     its[k].push_back(st.solver_iterations);
                     setup[k].push_back(st.stiffness_ms);
                 }
-            std::printf("| %s | %zu | %g | %.0f | %.0f / %.0f | %.2f | %.2f / %.2f | %.2f | %.2f | %.2f / %.2f | %.1f |\n",
+            std::printf("| %s | %zu | %g | %.0f | %.0f / %.0f | %.2f | %.2f / %.2f | %.2f | %.2f | %.2f | %.2f | %.2f / %.2f | "
+                        "%.1f |\n",
                         m.c_str(), s.mesh.X.size(), dt, median(its[0]), median(its[1]), median(its[2]), median(ms[0]),
-                        median(ms[1]), median(ms[2]), median(ms[2]) / median(ms[0]), median(setup[0]), median(setup[1]),
-                        median(setup[2]), first);
+                        median(ms[1]), median(ms[2]), median(ms[2]) / median(ms[0]), median(ms[3]),
+                        median(ms[3]) / median(ms[0]), median(setup[0]), median(setup[1]), median(setup[2]), first);
             std::fflush(stdout);
         }
 }
