@@ -190,19 +190,27 @@ SparseRows block_diagonal(const std::vector<double>& Dinv, int bs, Eigen::Index 
 // y = f D^-1 v + keep y, D^-1 given by its bs x bs inverse blocks (keep 0:
 // y overwritten).
 // Nodes [first, last) only (block_apply_range), or all of them.
-void block_apply_range(const std::vector<double>& Dinv, int bs, const double* v, double* y, double f, double keep,
-                       std::size_t first, std::size_t last) {
-    const std::size_t bb = std::size_t(bs * bs);
+template <int BS>
+void block_apply_sized(const std::vector<double>& Dinv, int bs_runtime, const double* v, double* y, double f,
+                       double keep, std::size_t first, std::size_t last) {
+    const std::size_t bs = BS ? std::size_t(BS) : std::size_t(bs_runtime), bb = bs * bs;
     for (std::size_t i = first; i < last; ++i) {
         const double* m = &Dinv[i * bb];
-        const double* vi = v + i * std::size_t(bs);
-        double* yi = y + i * std::size_t(bs);
-        for (int a = 0; a < bs; ++a) {
+        const double* vi = v + i * bs;
+        double* yi = y + i * bs;
+        for (std::size_t a = 0; a < bs; ++a) {
             double s = 0;
-            for (int c = 0; c < bs; ++c) s += m[a * bs + c] * vi[c];
+            for (std::size_t c = 0; c < bs; ++c) s += m[a * bs + c] * vi[c];
             yi[a] = keep == 0 ? f * s : keep * yi[a] + f * s;
         }
     }
+}
+// (3- and 6-dof nodes with compile-time sizes, so that the loops unroll)
+void block_apply_range(const std::vector<double>& Dinv, int bs, const double* v, double* y, double f, double keep,
+                       std::size_t first, std::size_t last) {
+    if (bs == 3) return block_apply_sized<3>(Dinv, bs, v, y, f, keep, first, last);
+    if (bs == 6) return block_apply_sized<6>(Dinv, bs, v, y, f, keep, first, last);
+    block_apply_sized<0>(Dinv, bs, v, y, f, keep, first, last);
 }
 void block_apply(const std::vector<double>& Dinv, int bs, const double* v, double* y, double f, double keep) {
     block_apply_range(Dinv, bs, v, y, f, keep, 0, Dinv.size() / std::size_t(bs * bs));
@@ -284,9 +292,27 @@ struct BlockRows {
             start[I + 1] = int(col.size());
         }
     }
+    // Calls f(B, C) with the block sizes as compile-time constants where
+    // they are the usual 3 and 6 (the loops below then unroll), as 0 (read
+    // rb and cb at run time) otherwise. The same arithmetic either way.
+    template <class F>
+    void with_sizes(const F& f) const {
+        using Three = std::integral_constant<int, 3>;
+        using Six = std::integral_constant<int, 6>;
+        using Any = std::integral_constant<int, 0>;
+        if (rb == 6 && cb == 6) return f(Six{}, Six{});
+        if (rb == 3 && cb == 6) return f(Three{}, Six{});
+        if (rb == 6 && cb == 3) return f(Six{}, Three{});
+        if (rb == 3 && cb == 3) return f(Three{}, Three{});
+        f(Any{}, Any{});
+    }
     // y = M x on rows [r0, r1) (whole blocks)
     void times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
+        with_sizes([&](auto B, auto C) { times_sized<B(), C()>(x, y, r0, r1); });
+    }
+    template <int B, int C>
+    void times_sized(const double* x, double* y, std::size_t r0, std::size_t r1) const {
+        const std::size_t b = B ? std::size_t(B) : std::size_t(rb), c = C ? std::size_t(C) : std::size_t(cb);
         double s[kModes];
         for (std::size_t I = r0 / b; I < r1 / b; ++I) {
             std::fill(s, s + b, 0.0);
@@ -303,17 +329,17 @@ struct BlockRows {
     // multiply-adds in increasing column order: bitwise transposed()'s
     // transpose_add(x, y).
     void times_add(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
-        for (std::size_t I = r0 / b; I < r1 / b; ++I)
-            for (std::size_t i = 0; i < b; ++i) {
-                double s = y[I * b + i];
-                for (int k = start[I]; k < start[I + 1]; ++k) {
-                    const float* v = &val[(std::size_t(k) * b + i) * c];
-                    const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
-                    for (std::size_t j = 0; j < c; ++j) s = std::fma(double(v[j]), xj[j], s);
-                }
-                y[I * b + i] = s;
-            }
+        with_sizes([&](auto B, auto C) { times_add_sized<B(), C()>(x, y, r0, r1); });
+    }
+    template <int B, int C>
+    void times_add_sized(const double* x, double* y, std::size_t r0, std::size_t r1) const {
+        const std::size_t b = B ? std::size_t(B) : std::size_t(rb);
+        double s[kModes];
+        for (std::size_t I = r0 / b; I < r1 / b; ++I) {
+            std::copy(y + I * b, y + I * b + b, s);
+            accumulate_row<B, C>(I, x, s);
+            std::copy(s, s + b, y + I * b);
+        }
     }
     // y = M^T x, scattered row by row. Fused multiply-adds, spelt out:
     // gather_times on the stored transpose adds the same terms in the same
@@ -325,29 +351,55 @@ struct BlockRows {
     }
     // y += M^T x, the same scatter.
     void transpose_add(const double* x, double* y) const {
-        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
-        for (std::size_t I = 0; I + 1 < start.size(); ++I)
-            for (std::size_t i = 0; i < b; ++i)
-                for (int k = start[I]; k < start[I + 1]; ++k) {
-                    const float* v = &val[(std::size_t(k) * b + i) * c];
-                    double* yj = y + std::size_t(col[std::size_t(k)]) * c;
-                    for (std::size_t j = 0; j < c; ++j) yj[j] = std::fma(double(v[j]), x[I * b + i], yj[j]);
+        with_sizes([&](auto B, auto C) { transpose_add_sized<B(), C()>(x, y); });
+    }
+    template <int B, int C>
+    void transpose_add_sized(const double* x, double* y) const {
+        const std::size_t b = B ? std::size_t(B) : std::size_t(rb), c = C ? std::size_t(C) : std::size_t(cb);
+        // each y_j gets block row I's terms in row order, summed in a
+        // register (the order of the row-by-row scatter, without a store
+        // and reload between the rows)
+        for (std::size_t I = 0; I + 1 < start.size(); ++I) {
+            const double* xi = x + I * b;
+            for (int k = start[I]; k < start[I + 1]; ++k) {
+                const float* v = &val[std::size_t(k) * b * c];
+                double* yj = y + std::size_t(col[std::size_t(k)]) * c;
+                for (std::size_t j = 0; j < c; ++j) {
+                    double t = yj[j];
+                    for (std::size_t i = 0; i < b; ++i) t = std::fma(double(v[i * c + j]), xi[i], t);
+                    yj[j] = t;
                 }
+            }
+        }
     }
     // Rows [r0, r1) of y = M x for M = transposed() of a matrix N: bitwise
     // N.transpose_times(x, y) there.
     void gather_times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        const std::size_t b = std::size_t(rb), c = std::size_t(cb);
-        for (std::size_t I = r0 / b; I < r1 / b; ++I)
-            for (std::size_t i = 0; i < b; ++i) {
-                double s = 0;
-                for (int k = start[I]; k < start[I + 1]; ++k) {
-                    const float* v = &val[(std::size_t(k) * b + i) * c];
-                    const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
-                    for (std::size_t j = 0; j < c; ++j) s = std::fma(double(v[j]), xj[j], s);
-                }
-                y[I * b + i] = s;
-            }
+        with_sizes([&](auto B, auto C) { gather_times_sized<B(), C()>(x, y, r0, r1); });
+    }
+    template <int B, int C>
+    void gather_times_sized(const double* x, double* y, std::size_t r0, std::size_t r1) const {
+        const std::size_t b = B ? std::size_t(B) : std::size_t(rb);
+        double s[kModes];
+        for (std::size_t I = r0 / b; I < r1 / b; ++I) {
+            std::fill(s, s + b, 0.0);
+            accumulate_row<B, C>(I, x, s);
+            std::copy(s, s + b, y + I * b);
+        }
+    }
+    // s_i += (M x)_i for the rows i of block row I, each by fused
+    // multiply-adds in increasing column order; the block's rows are
+    // interleaved (independent sums: no wait on one fma's latency), which
+    // changes no sum's order.
+    template <int B, int C>
+    void accumulate_row(std::size_t I, const double* x, double* s) const {
+        const std::size_t b = B ? std::size_t(B) : std::size_t(rb), c = C ? std::size_t(C) : std::size_t(cb);
+        for (int k = start[I]; k < start[I + 1]; ++k) {
+            const float* v = &val[std::size_t(k) * b * c];
+            const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
+            for (std::size_t j = 0; j < c; ++j)
+                for (std::size_t i = 0; i < b; ++i) s[i] = std::fma(double(v[i * c + j]), xj[j], s[i]);
+        }
     }
     // M^T with each block row's blocks in increasing block column order:
     // its row j times x adds the terms of column j in the order
