@@ -96,6 +96,24 @@ TEST(StressSuite, EnergyInjectionIsCaughtAndRoundOffIsConvergence) {
     }
 }
 
+// The 0.1-degree sliver cube under bdf2-linear does not come back to rest
+// (1.3e-3 of its size away after 10 s, tolerance 1e-3): it settles into one
+// of StVK's inverted equilibria (a sliver flipped through its own plane
+// stores almost no energy). Not silent: the end state has inverted tets,
+// which every step's StepStats::inverted_tets reports; an off-rest end
+// without them would be a FAIL.
+TEST(StressSuite, ARunThatSettlesAwayFromRestEndsWithItsTetsReportedInverted) {
+    const auto rs = run("sliver(min dih 0.1deg) bdf2-linear", 10.0);
+    ASSERT_EQ(rs.size(), 1u);
+    const StressResult& r = rs[0];
+    EXPECT_NE(r.verdict, StressVerdict::Fail) << r.reason;
+    EXPECT_NEAR(r.simulated, 10.0, 1e-9) << r.reason;
+    if (!(r.recovery <= kRecoveryTolerance)) {
+        EXPECT_EQ(r.verdict, StressVerdict::Reported) << r.reason;
+        EXPECT_GT(r.final_inverted, 0) << r.reason;
+    }
+}
+
 TEST(StressSuite, NoRunOfTheQuickSuiteIsSilentNaN) {
     // Whatever the verdict, a non-finite state must surface as a
     // SimulationError: a FAIL may be energy growth or no recovery, never a
