@@ -81,10 +81,10 @@ bool g_amg_only = false;                    // --amg-only: the matrix part witho
 std::string describe(const AmgSettings& a) {
     char buf[256];
     std::snprintf(buf, sizeof buf,
-                  "AMG: %s smoother, %d step(s), coarsest <= %d dofs, <= %d levels, Chebyshev ratio %g, prolongator "
-                  "weight %g, strength %g",
+                  "AMG: %s smoother, %d step(s), coarsest <= %d dofs or a coarse level >= %g nonzero, <= %d levels, "
+                  "Chebyshev ratio %g, prolongator weight %g, strength %g",
                   a.smoother == AmgSmoother::Chebyshev ? "Chebyshev" : "l1 block-Jacobi", a.smoothing_steps,
-                  a.max_coarse_dofs, a.max_levels, a.chebyshev_ratio, a.prolongator_weight, a.strength);
+                  a.max_coarse_dofs, a.dense_coarsest, a.max_levels, a.chebyshev_ratio, a.prolongator_weight, a.strength);
     return buf;
 }
 
@@ -544,6 +544,7 @@ int main(int argc, char** argv) {
         else if (a == "--parts") parts = next();
         else if (a == "--amg-smoothing") g_amg.smoothing_steps = std::max(1, std::stoi(next()));
         else if (a == "--amg-coarse") g_amg.max_coarse_dofs = std::max(1, std::stoi(next()));
+        else if (a == "--amg-dense") g_amg.dense_coarsest = std::stod(next());
         else if (a == "--no-hypre") g_no_hypre = true;
         else if (a == "--threads") g_threads = std::max(1, std::stoi(next()));
         else if (a == "--amg-only") g_amg_only = true;

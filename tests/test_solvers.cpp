@@ -154,7 +154,9 @@ TEST(SmoothedAggregation, TentativeProlongatorsReproduceTheRigidBodyModes) {
             for (SparseRows::InnerIterator it(A, k); it; ++it)
                 if (!free_dof[std::size_t(it.row())] || !free_dof[std::size_t(it.col())]) it.valueRef() = 0;
         SmoothedAggregation amg;
-        amg.build(A, mesh.X, free_dof, AmgSettings{100, 8, 1, 12});
+        AmgSettings settings{100, 8, 1, 12};
+        settings.dense_coarsest = 0;  // three levels or more
+        amg.build(A, mesh.X, free_dof, settings);
         ASSERT_GE(amg.levels(), 3);
         for (int l = 0; l + 1 < amg.levels(); ++l) {
             const Eigen::MatrixXd& Bl = amg.near_nullspace(l);
@@ -221,11 +223,14 @@ BoxSystem box_system(index_t nx, index_t ny, index_t nz, std::size_t fixed) {
     return b;
 }
 
-AmgSettings smoother_settings(AmgSmoother kind, int steps, int max_coarse_dofs) {
+// dense_coarsest 0: these boxes coarsen to at least 3 levels (the default
+// would stop at a dense level 1 on the smaller ones)
+AmgSettings smoother_settings(AmgSmoother kind, int steps, int max_coarse_dofs, double dense_coarsest = 0) {
     AmgSettings a;
     a.smoother = kind;
     a.smoothing_steps = steps;
     a.max_coarse_dofs = max_coarse_dofs;
+    a.dense_coarsest = dense_coarsest;
     return a;
 }
 
@@ -242,12 +247,17 @@ TEST(SmoothedAggregation, VCycleIsSymmetricAndPositiveWithEachSmoother) {
         r1[i] = sys.free_dof[std::size_t(i)] ? std::sin(1.0 + double(i)) : 0.0;
         r2[i] = sys.free_dof[std::size_t(i)] ? std::cos(0.7 * double(i)) : 0.0;
     }
+    // dense_coarsest 0: three levels or more; the default: the dense level 1
+    // is the coarsest (its float LDL^T the coarse solve)
+    for (const double dense : {0.0, AmgSettings{}.dense_coarsest})
     for (const AmgSmoother kind : {AmgSmoother::L1Jacobi, AmgSmoother::Chebyshev})
         for (int steps : {1, 2, 3}) {
-            SCOPED_TRACE((kind == AmgSmoother::Chebyshev ? "Chebyshev degree " : "l1 sweeps ") + std::to_string(steps));
+            SCOPED_TRACE((kind == AmgSmoother::Chebyshev ? "Chebyshev degree " : "l1 sweeps ") + std::to_string(steps) +
+                         ", dense_coarsest " + std::to_string(dense));
             SmoothedAggregation amg;
-            amg.build(A, sys.mesh.X, sys.free_dof, smoother_settings(kind, steps, 100));
-            ASSERT_GE(amg.levels(), 3);
+            amg.build(A, sys.mesh.X, sys.free_dof, smoother_settings(kind, steps, 100, dense));
+            if (dense == 0) ASSERT_GE(amg.levels(), 3);
+            else ASSERT_EQ(amg.levels(), 2);
             amg.apply(r1.data(), z1.data(), fine);
             amg.apply(r2.data(), z2.data(), fine);
             // <r2, M r1> = <r1, M r2> to round-off: PCG's preconditioner must be symmetric.

@@ -6,7 +6,7 @@
 
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/executor.hpp"
-#include "edgefem/core/sparse_cholesky.hpp"
+#include "amg/coarse_ldlt.hpp"
 
 namespace edgefem {
 
@@ -445,29 +445,6 @@ struct BlockRows {
     std::size_t bytes() const { return start.size() * sizeof(int) + col.size() * sizeof(int) + val.size() * sizeof(float); }
 };
 
-// The lower triangle of A (symmetric) with a unit diagonal on dofs whose
-// row is zero (a prolongator column without a mode: a constrained or
-// degenerate aggregate), for the coarsest factorisation.
-LowerCsc lower_with_unit_dead(const SparseRows& A) {
-    std::vector<Eigen::Triplet<double, int>> t;
-    for (int i = 0; i < A.outerSize(); ++i) {
-        bool dead = true;
-        for (SparseRows::InnerIterator it(A, i); it; ++it) {
-            dead = dead && it.value() == 0;
-            if (it.col() <= i) t.emplace_back(i, int(it.col()), it.value());
-        }
-        if (dead) t.emplace_back(i, i, 1.0);
-    }
-    Eigen::SparseMatrix<double, Eigen::ColMajor, int> C(A.rows(), A.cols());  // column-major lower
-    C.setFromTriplets(t.begin(), t.end());
-    C.makeCompressed();
-    LowerCsc out;
-    out.n = index_t(A.rows());
-    out.col_start.assign(C.outerIndexPtr(), C.outerIndexPtr() + C.cols() + 1);
-    out.row.assign(C.innerIndexPtr(), C.innerIndexPtr() + C.nonZeros());
-    out.value.assign(C.valuePtr(), C.valuePtr() + C.nonZeros());
-    return out;
-}
 
 }  // namespace
 
@@ -509,8 +486,7 @@ struct SmoothedAggregation::Impl {
     };
     AmgSettings settings;
     std::vector<Level> level;
-    SparseCholesky coarse;
-    mutable Eigen::VectorXd coarse_rhs;
+    amg::CoarseLdlt coarse;
     std::shared_ptr<const Executor> ex;  // null or one thread: serial
 
     bool threaded() const { return ex && ex->threads() > 1; }
@@ -651,9 +627,9 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         throw InvalidArgument("SmoothedAggregation::build: A must be 3 #V square with 3 #V coordinates and free flags");
     if (settings.max_coarse_dofs < 1 || settings.max_levels < 1 || settings.smoothing_steps < 1 ||
         settings.power_iterations < 1 || !(settings.chebyshev_ratio > 1) || !(settings.prolongator_weight >= 0) ||
-        !(settings.strength >= 0))
+        !(settings.strength >= 0) || !(settings.dense_coarsest >= 0 && settings.dense_coarsest <= 1))
         throw InvalidArgument("AmgSettings: max_coarse_dofs, max_levels, smoothing_steps and power_iterations must be "
-                              ">= 1, chebyshev_ratio > 1, prolongator_weight and strength >= 0");
+                              ">= 1, chebyshev_ratio > 1, prolongator_weight and strength >= 0, dense_coarsest in [0, 1]");
     Impl& m = *impl_;
     m.settings = settings;
     m.level.clear();
@@ -667,6 +643,9 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         Impl::Level& L = m.level.back();
         const int bs = L.bs;
         if (Al.rows() <= settings.max_coarse_dofs || int(m.level.size()) >= settings.max_levels) break;
+        if (m.level.size() > 1 && settings.dense_coarsest > 0 &&
+            double(Al.nonZeros()) >= settings.dense_coarsest * double(Al.rows()) * double(Al.rows()))
+            break;
         index_t count = 0;
         // The finest level aggregates on the whole edge graph; coarser ones
         // on their strong couplings only.
@@ -739,8 +718,7 @@ void SmoothedAggregation::refresh(const SparseRows& A) {
             if (cheb) L.lambda = largest_eigenvalue(*Al, L.Minv, L.bs, m.settings.power_iterations);
         } else {
             L.Minv.assign(std::size_t(Al->rows()) * std::size_t(L.bs), 0.0);  // sizes only
-            if (!m.coarse.factor(lower_with_unit_dead(*Al)))
-                throw Error("AMG: the coarsest level's factorisation failed (a zero pivot)");
+            if (!m.coarse.factor(*Al)) throw Error("AMG: the coarsest level's factorisation failed (a zero pivot)");
         }
     }
 }
@@ -789,7 +767,7 @@ std::size_t SmoothedAggregation::bytes() const {
     for (const auto& L : impl_->level)
         b += L.A.bytes() + L.P.bytes() + L.R.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
              L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t);
-    b += std::size_t(impl_->coarse.factor_nonzeros() * sizeof(double));
+    b += impl_->coarse.bytes();
     return b;
 }
 

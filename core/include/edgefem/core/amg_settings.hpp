@@ -11,12 +11,9 @@ enum class AmgSmoother {
 };
 
 struct AmgSettings {
-    // The coarsest level is factorised (CHOLMOD) once it has at most this
-    // many dofs. 1000, not 250: bunny-4k then stops at its 462-dof level 1,
-    // whose factor solve costs less than the two further levels' smoothing
-    // (AMG / block-Jacobi step 1.45 -> 0.87 at dt = 4 ms); larger meshes keep
-    // their levels (docs/solvers.md).
-    int max_coarse_dofs = 1000;
+    // A level with at most this many dofs is the coarsest (factorised:
+    // a dense LDL^T, rounded to float).
+    int max_coarse_dofs = 250;
     int max_levels = 8;
     // Before and after the coarse correction: the Chebyshev degree or the
     // number of l1 sweeps; either costs 2 x smoothing_steps products with
@@ -35,6 +32,13 @@ struct AmgSettings {
     // couplings to coarsen (bunny-4k at 1 ms: 462 -> 246 dofs, dense below);
     // 0.04: the same iterations, less memory (docs/solvers.md, "Memory").
     double strength = 0.04;
+    // A coarse level (not the finest) whose operator has at least this share
+    // of its entries nonzero is the coarsest too: its two triangular solves
+    // (n^2 multiply-adds) then cost no more than the four products with it
+    // (4 nnz) a V-cycle would spend there, before the levels below. bunny-4k
+    // stops at its 462-dof level 1 (38 % nonzero): AMG / block-Jacobi step
+    // 1.45 -> 0.65 at dt = 4 ms (docs/solvers.md); 0 turns it off.
+    double dense_coarsest = 0.25;
 };
 
 }  // namespace edgefem

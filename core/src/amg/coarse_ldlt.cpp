@@ -1,0 +1,81 @@
+#include "amg/coarse_ldlt.hpp"
+
+// Eigen's dense LDLT, inlined here, trips g++ 12's false
+// -Wmaybe-uninitialized with AVX-512 (GCC PR 105593); this file's only
+// dense kernel is that factorisation.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <Eigen/Dense>
+
+#include <cmath>
+
+namespace edgefem::amg {
+
+bool CoarseLdlt::factor(const SparseRows& A) {
+    n_ = std::size_t(A.rows());
+    const auto n = Eigen::Index(n_);
+    // Dense and symmetric from the lower triangle; a dof whose row is zero
+    // (a prolongator column without a mode: a constrained or degenerate
+    // aggregate) gets a unit diagonal.
+    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        bool dead = true;
+        for (SparseRows::InnerIterator it(A, i); it; ++it) {
+            dead = dead && it.value() == 0;
+            if (it.col() <= i) D(i, it.col()) = D(it.col(), i) = it.value();
+        }
+        if (dead) D(i, i) = 1.0;
+    }
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(D);
+    if (ldlt.info() != Eigen::Success) return false;
+    // P A P^T = L D L^T: (P b)_k = b[perm_[k]]
+    Eigen::VectorXd iota(n);
+    for (Eigen::Index i = 0; i < n; ++i) iota[i] = double(i);
+    const Eigen::VectorXd moved = ldlt.transpositionsP() * iota;
+    perm_.resize(n_);
+    for (std::size_t k = 0; k < n_; ++k) perm_[k] = int(moved[Eigen::Index(k)]);
+    const Eigen::MatrixXd L = ldlt.matrixL();
+    d_.resize(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+        d_[i] = ldlt.vectorD()[Eigen::Index(i)];
+        if (!std::isfinite(d_[i]) || d_[i] == 0) return false;
+    }
+    lower_.resize(n_ * (n_ - (n_ > 0)) / 2);
+    for (std::size_t i = 1; i < n_; ++i)
+        for (std::size_t j = 0; j < i; ++j) {
+            const double l = L(Eigen::Index(i), Eigen::Index(j));
+            if (!std::isfinite(l)) return false;
+            lower_[i * (i - 1) / 2 + j] = float(l);
+        }
+    y_.resize(n_);
+    return true;
+}
+
+void CoarseLdlt::solve(const double* b, double* x) const {
+    double* y = y_.data();
+    // y = L^-1 P b, row by row; each row's sum in four interleaved partial
+    // sums (a fixed order: the same bits on every call)
+    for (std::size_t i = 0; i < n_; ++i) {
+        const float* row = &lower_[i * (i - (i > 0)) / 2];
+        double s[4] = {0, 0, 0, 0};
+        std::size_t j = 0;
+        for (; j + 4 <= i; j += 4)
+            for (int q = 0; q < 4; ++q) s[q] += double(row[j + std::size_t(q)]) * y[j + std::size_t(q)];
+        for (; j < i; ++j) s[0] += double(row[j]) * y[j];
+        y[i] = b[perm_[i]] - ((s[0] + s[1]) + (s[2] + s[3]));
+    }
+    for (std::size_t i = 0; i < n_; ++i) y[i] /= d_[i];
+    // L^-T, column-oriented: row j of the packed L is column j of L^T
+    for (std::size_t j = n_; j-- > 1;) {
+        const float* row = &lower_[j * (j - 1) / 2];
+        const double yj = y[j];
+        for (std::size_t i = 0; i < j; ++i) y[i] -= double(row[i]) * yj;
+    }
+    for (std::size_t k = 0; k < n_; ++k) x[perm_[k]] = y[k];
+}
+
+std::size_t CoarseLdlt::bytes() const {
+    return lower_.size() * sizeof(float) + d_.size() * sizeof(double) + perm_.size() * sizeof(int) +
+           y_.size() * sizeof(double);
+}
+
+}  // namespace edgefem::amg
