@@ -329,17 +329,7 @@ struct BlockRows {
     // multiply-adds in increasing column order: bitwise transposed()'s
     // transpose_add(x, y).
     void times_add(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        with_sizes([&](auto B, auto C) { times_add_sized<B(), C()>(x, y, r0, r1); });
-    }
-    template <int B, int C>
-    void times_add_sized(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        const std::size_t b = B ? std::size_t(B) : std::size_t(rb);
-        double s[kModes];
-        for (std::size_t I = r0 / b; I < r1 / b; ++I) {
-            std::copy(y + I * b, y + I * b + b, s);
-            accumulate_row<B, C>(I, x, s);
-            std::copy(s, s + b, y + I * b);
-        }
+        with_sizes([&](auto B, auto C) { fused_rows<B(), C(), true>(x, y, r0, r1); });
     }
     // y = M^T x, scattered row by row. Fused multiply-adds, spelt out:
     // gather_times on the stored transpose adds the same terms in the same
@@ -375,14 +365,17 @@ struct BlockRows {
     // Rows [r0, r1) of y = M x for M = transposed() of a matrix N: bitwise
     // N.transpose_times(x, y) there.
     void gather_times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        with_sizes([&](auto B, auto C) { gather_times_sized<B(), C()>(x, y, r0, r1); });
+        with_sizes([&](auto B, auto C) { fused_rows<B(), C(), false>(x, y, r0, r1); });
     }
-    template <int B, int C>
-    void gather_times_sized(const double* x, double* y, std::size_t r0, std::size_t r1) const {
+    // Rows [r0, r1) of y (+)= M x (Add: from y's values, else from zero),
+    // each y_i by fused multiply-adds in increasing column order.
+    template <int B, int C, bool Add>
+    void fused_rows(const double* x, double* y, std::size_t r0, std::size_t r1) const {
         const std::size_t b = B ? std::size_t(B) : std::size_t(rb);
         double s[kModes];
         for (std::size_t I = r0 / b; I < r1 / b; ++I) {
-            std::fill(s, s + b, 0.0);
+            if (Add) std::copy(y + I * b, y + I * b + b, s);
+            else std::fill(s, s + b, 0.0);
             accumulate_row<B, C>(I, x, s);
             std::copy(s, s + b, y + I * b);
         }
