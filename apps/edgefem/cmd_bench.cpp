@@ -36,6 +36,9 @@ struct BenchOptions {
     std::string kernel;
     double seconds = 1.0;
     int cg_iters = 0;  // step: > 0 runs exactly this many CG iterations
+    double dt = 1e-3;  // step: the time step (s)
+    std::string preconditioner = "auto";  // step: CG's preconditioner
+    std::string linear = "cg";  // step: cg or direct
     bool stream = false;  // also measure the STREAM bandwidth on the same executor
     int stream_rounds = 5;  // with stream: kernel and triad alternate this many times
 };
@@ -100,15 +103,35 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
     scene.method = opts.model.method_kind() == Method::Tet ? edgefem::Method::Tet : edgefem::Method::Edge;
     scene.solver.cg_tolerance = 1e-6;
     scene.solver.cg_fixed_iterations = opts.cg_iters;
+    scene.dt = opts.dt;
+    scene.solver.preconditioner = parse_preconditioner(opts.preconditioner, "--preconditioner");
+    scene.solver.linear_solver = opts.linear == "direct" ? LinearSolver::Direct : LinearSolver::CG;
+    scene.validate();
     const auto ex = make_run_executor(opts.run);
     Simulator<S> sim(std::move(scene), ex, operator_factory<S>(opts.run, ex, opts.model.layout_kind()));
 
+    // The first step alone: it holds the one-off set-up (the AMG's
+    // hierarchy, the direct solver's analysis).
+    const auto t0 = std::chrono::steady_clock::now();
+    sim.step();
+    const double first_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::vector<int> iterations;  // of the timed calls (cleared after the warm-up, so bounded as they are)
+    std::vector<double> setup_ms;  // K and the solver's set-up per step (StepStats::stiffness_ms)
     BarrierProbe probe(ex);
-    const std::vector<double> ns =
-        time_calls(opts.seconds, [&] { iterations.push_back(sim.step().solver_iterations); }, 5, kMaxTimedCalls,
-                   [&] { iterations.clear(); });
+    const std::vector<double> ns = time_calls(
+        opts.seconds,
+        [&] {
+            const StepStats& st = sim.step();
+            iterations.push_back(st.solver_iterations);
+            setup_ms.push_back(st.stiffness_ms);
+        },
+        5, kMaxTimedCalls,
+        [&] {
+            iterations.clear();
+            setup_ms.clear();
+        });
     probe.finish();
+    std::sort(setup_ms.begin(), setup_ms.end());
     double mean_iterations = 0;
     for (int i : iterations) mean_iterations += i;
     mean_iterations /= double(iterations.size());
@@ -116,6 +139,11 @@ void bench_step(const BenchOptions& opts, Mesh mesh) {
 
     print_header(opts, sim.scene().mesh);
     print_kv("fixed_vertices", sim.scene().fixed.size());
+    print_kv("dt", fmt(sim.scene().dt, 6));
+    print_kv("linear", opts.linear);
+    if (opts.linear == "cg") print_kv("preconditioner", opts.preconditioner);
+    print_kv("first_step_ms", fmt(first_ms, 6));
+    print_kv("median_setup_ms_per_step", fmt(setup_ms[setup_ms.size() / 2], 6));
     print_kv("steps", ns.size());
     print_kv("median_ms_per_step", fmt(median * 1e-6, 6));
     print_kv("min_ms_per_step", fmt(ns.front() * 1e-6, 6));
@@ -164,6 +192,9 @@ void run_bench(const BenchOptions& opts) {
     opts.model.validate();
     if (opts.stream && opts.kernel == "step") throw InvalidArgument("--stream does not apply to --kernel step");
     if (opts.cg_iters > 0 && opts.kernel != "step") throw InvalidArgument("--cg-iters applies only to --kernel step");
+    if (opts.kernel != "step" && (opts.dt != 1e-3 || opts.preconditioner != "auto" || opts.linear != "cg"))
+        throw InvalidArgument("--dt, --preconditioner and --linear apply only to --kernel step");
+    parse_preconditioner(opts.preconditioner, "--preconditioner");  // a bad name fails before the mesh loads
     LoadedMesh lm = load_mesh(opts.mesh);
     check_mesh_scale(lm.mesh, opts.model.precision_kind(), opts.mesh.path);
     // The step's scene gives every vertex mass from its tets; without this
@@ -289,8 +320,9 @@ void add_bench_command(CLI::App& app) {
                     "force: forces only (no energy); stiffness: K from a previous force call's state (edge) or "
                     "the per-tet 12x12 blocks (tet); force+stiffness: both; kx: y = K x with K precomputed "
                     "(edge: per-edge blocks, tet: stored per-tet blocks); step: one semi-implicit step "
-                    "(dt = 1 ms, gravity -z, the lowest 1% of the mesh along z fixed, CG to 1e-6 or "
-                    "--cg-iters iterations), successive steps from the moving state")
+                    "(--dt, 1 ms by default; gravity -z, the lowest 1% of the mesh along z fixed, CG to 1e-6 or "
+                    "--cg-iters iterations, --preconditioner, or --linear direct), successive steps from the moving "
+                    "state; it reports the first step (the one-off set-up) apart")
         ->required()
         ->check(CLI::IsMember({"force", "stiffness", "force+stiffness", "kx", "step"}));
     auto* stream_flag = cmd->add_flag("--stream", opts->stream,
@@ -307,6 +339,13 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--cg-iters", opts->cg_iters,
                     "step: run exactly N warm-started CG iterations per step instead of solving to 1e-6")
         ->check(int_in_range(1));
+    cmd->add_option("--dt", opts->dt, "step: the time step (s), at most 1")->check(seconds_at_most(1))->capture_default_str();
+    cmd->add_option("--preconditioner", opts->preconditioner,
+                    "step: CG's preconditioner: auto, block-jacobi or amg (docs/solvers.md)")
+        ->capture_default_str();
+    cmd->add_option("--linear", opts->linear, "step: cg (matrix-free, --preconditioner) or direct (CHOLMOD)")
+        ->check(CLI::IsMember({"cg", "direct"}))
+        ->capture_default_str();
     cmd->add_option("--seconds", opts->seconds, "Time budget of the timed calls, at most 3600")
         ->check(seconds_at_most(3600))
         ->capture_default_str();
