@@ -76,6 +76,7 @@ double median(std::vector<double> v) {
 AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
 bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
 int g_threads = 1;                          // --threads N: the step part on the pool back-end's N threads
+std::vector<double> g_youngs;  // --youngs: Young's moduli to step each mesh at (empty: the scene's own)
 bool g_amg_only = false;                    // --amg-only: the matrix part without block-Jacobi (large meshes)
 
 std::string describe(const AmgSettings& a) {
@@ -238,13 +239,19 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
                 "AMG: its Galerkin operators refreshed at every K (`amg_refresh_interval` 1) or lagged (0, the "
                 "default: refreshed when the iterations grow 1.5x).\n\n",
                 ex ? ("pool x" + std::to_string(g_threads)).c_str() : "serial", rounds);
-    std::printf("| mesh | dofs | dt ms | BJ its | AMG its (every K / lagged) | BJ ms/step | AMG ms/step (every K / lagged) | "
+    std::printf("| mesh | dofs | Y Pa | dt ms | BJ its | AMG its (every K / lagged) | BJ ms/step | AMG ms/step (every K / lagged) | "
                 "lagged AMG / BJ | direct ms/step | direct / BJ | BJ set-up ms | AMG set-up ms (every K / lagged) | "
                 "AMG first step ms |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    const std::vector<double> own{0.0};
     for (const std::string& m : meshes)
+        for (double young : g_youngs.empty() ? own : g_youngs)
         for (double dt : dts) {
             Scene s = named_scene(m);
+            if (young > 0) {
+                s.materials.fallback.young = young;
+                for (auto& [region, mat] : s.materials.by_region) mat.young = young;
+            }
             Scene sb = s, sa = s, sl = s, sd = s;
             for_solve(sb, dt, PreconditionerKind::BlockJacobi);
             for_solve(sd, dt, PreconditionerKind::BlockJacobi);
@@ -273,9 +280,9 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
                     its[k].push_back(st.solver_iterations);
                     setup[k].push_back(st.stiffness_ms);
                 }
-            std::printf("| %s | %zu | %g | %.0f | %.0f / %.0f | %.2f | %.2f / %.2f | %.2f | %.2f | %.2f | %.2f | %.2f / %.2f | "
-                        "%.1f |\n",
-                        m.c_str(), s.mesh.X.size(), dt, median(its[0]), median(its[1]), median(its[2]), median(ms[0]),
+            std::printf("| %s | %zu | %g | %g | %.0f | %.0f / %.0f | %.2f | %.2f / %.2f | %.2f | %.2f | %.2f | %.2f | "
+                        "%.2f / %.2f | %.1f |\n",
+                        m.c_str(), s.mesh.X.size(), s.materials.fallback.young, dt, median(its[0]), median(its[1]), median(its[2]), median(ms[0]),
                         median(ms[1]), median(ms[2]), median(ms[2]) / median(ms[0]), median(ms[3]),
                         median(ms[3]) / median(ms[0]), median(setup[0]), median(setup[1]), median(setup[2]), first);
             std::fflush(stdout);
@@ -545,6 +552,9 @@ int main(int argc, char** argv) {
         else if (a == "--amg-smoothing") g_amg.smoothing_steps = std::max(1, std::stoi(next()));
         else if (a == "--amg-coarse") g_amg.max_coarse_dofs = std::max(1, std::stoi(next()));
         else if (a == "--amg-dense") g_amg.dense_coarsest = std::stod(next());
+        else if (a == "--youngs") {
+            for (const std::string& y : split(next())) g_youngs.push_back(std::stod(y));
+        }
         else if (a == "--no-hypre") g_no_hypre = true;
         else if (a == "--threads") g_threads = std::max(1, std::stoi(next()));
         else if (a == "--amg-only") g_amg_only = true;

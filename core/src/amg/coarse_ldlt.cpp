@@ -3,7 +3,9 @@
 // Eigen's dense LDLT, inlined here, trips g++ 12's false
 // -Wmaybe-uninitialized with AVX-512 (GCC PR 105593); this file's only
 // dense kernel is that factorisation.
+#if defined(__GNUC__) && !defined(__clang__)  // clang (the fuzz builds) has no such warning
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <Eigen/Dense>
 
 #include <cmath>
