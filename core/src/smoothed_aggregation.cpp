@@ -735,6 +735,7 @@ void SmoothedAggregation::smooth(int l, const double* b, double* x,
 }
 
 int SmoothedAggregation::levels() const { return int(impl_->level.size()); }
+bool SmoothedAggregation::coarsest_indefinite() const { return impl_->coarse.indefinite(); }
 index_t SmoothedAggregation::dofs(int l) const {
     const auto& L = impl_->level[std::size_t(l)];
     return index_t(L.Minv.size() / std::size_t(L.bs));

@@ -234,7 +234,7 @@ def test_preconditioner_setting():
     # error that names the setting.
     scene = clamped_box_scene(8, 3, 3)
     assert scene.solver.preconditioner == "auto"
-    assert scene.solver.auto_amg_iterations == 100
+    assert scene.solver.auto_amg_iterations == 60
     scene.dt = 4e-3
     scene.solver.cg_tolerance = 1e-11
     u = {}

@@ -37,9 +37,11 @@ bool CoarseLdlt::factor(const SparseRows& A) {
     for (std::size_t k = 0; k < n_; ++k) perm_[k] = int(moved[Eigen::Index(k)]);
     const Eigen::MatrixXd L = ldlt.matrixL();
     d_.resize(n_);
+    negative_ = false;
     for (std::size_t i = 0; i < n_; ++i) {
         d_[i] = ldlt.vectorD()[Eigen::Index(i)];
         if (!std::isfinite(d_[i]) || d_[i] == 0) return false;
+        negative_ = negative_ || d_[i] < 0;
     }
     lower_.resize(n_ * (n_ - (n_ > 0)) / 2);
     for (std::size_t i = 1; i < n_; ++i)

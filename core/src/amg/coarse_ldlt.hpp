@@ -26,6 +26,8 @@ public:
     void solve(const double* b, double* x) const;
     std::size_t bytes() const;
     std::size_t dofs() const { return n_; }
+    // Whether D has a negative entry: the operator is indefinite.
+    bool indefinite() const { return negative_; }
 
 private:
     std::size_t n_ = 0;
@@ -33,6 +35,7 @@ private:
     std::vector<float> lower_;   // L's strict lower triangle, row i at i (i - 1) / 2
     std::vector<double> d_;      // D
     mutable std::vector<double> y_;
+    bool negative_ = false;
 };
 
 }  // namespace edgefem::amg

@@ -51,9 +51,13 @@ public:
         built_ = true;
         c_ = c;
         age_ = 0;
-        stale_ = false;
+        // an indefinite A: refreshed at the next set-up (the definite K the
+        // step falls back to), not lagged
+        stale_ = amg_.coarsest_indefinite();
         fresh_iterations_ = -1;
     }
+
+    bool indefinite() const override { return amg_.coarsest_indefinite(); }
 
     void solved(int iterations) override {
         if (fresh_iterations_ < 0) fresh_iterations_ = iterations;

@@ -47,6 +47,7 @@ public:
         active_->load(r, A);
     }
     std::size_t bytes() const override { return active_->bytes(); }
+    bool indefinite() const override { return active_->indefinite(); }
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override { active_->apply(lo, hi, r, z); }
     bool whole_vector() const override { return active_->whole_vector(); }
 

@@ -26,10 +26,14 @@ public:
                    int fixed_iterations) override {
         const double s = solve_scale(A.c_m(), b, x);
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, true);
-        const CgResult res = s_.kernels.cg(A, *precond_, s_.free_dof.data(), b.data(), x.data(), s_.n(),
-                                           {tolerance, s_.scene.solver.cg_max_iterations, fixed_iterations}, work_);
+        CgResult res = s_.kernels.cg(A, *precond_, s_.free_dof.data(), b.data(), x.data(), s_.n(),
+                                     {tolerance, s_.scene.solver.cg_max_iterations, fixed_iterations}, work_);
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, false);
         precond_->solved(res.iterations);
+        if (precond_->indefinite()) {  // see Preconditioner::indefinite
+            res.negative_curvature = true;
+            res.converged = false;
+        }
         return res;
     }
 

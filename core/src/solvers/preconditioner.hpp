@@ -24,6 +24,12 @@ public:
     virtual void load(CheckpointReader& /*r*/, LinearSystem<S>& /*A*/) {}
     // Bytes it holds (the memory figures of docs/solvers.md).
     virtual std::size_t bytes() const = 0;
+    // Whether its last set-up found A indefinite (the AMG's coarsest
+    // factorisation met a negative pivot). CG then does not see the
+    // negative curvature itself (a V-cycle that solves A exactly makes
+    // p.Ap = r.A^-1 r, positive), so the solve reports it, as the direct
+    // solver's LDL^T does, and the step falls back to the definite K.
+    virtual bool indefinite() const { return false; }
 };
 
 // The scene's SolverSettings::preconditioner.

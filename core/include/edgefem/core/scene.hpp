@@ -66,7 +66,7 @@ struct SolverSettings {
     // Auto: the block-Jacobi CG iterations of one solve past which AMG takes
     // over for the rest of the run (docs/solvers.md has the measured
     // crossover). Never with cg_fixed_iterations, or off the host.
-    int auto_amg_iterations = 100;
+    int auto_amg_iterations = 60;
     // AMG: when its Galerkin operators and smoothers follow a new K (the
     // fine level's products are always the current K's). 0 (default): lagged
     // while CG's iterations stay within 1.5x (+ 2) of those right after the

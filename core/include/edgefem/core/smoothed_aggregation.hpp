@@ -54,6 +54,11 @@ public:
     void smooth(int level, const double* b, double* x, const std::function<void(const double*, double*)>& fine) const;
 
     int levels() const;                                // including the finest
+    // Whether the last build or refresh found the coarsest level's operator
+    // indefinite (a negative pivot of its LDL^T): then A is indefinite too
+    // (the Galerkin operator of a definite A is definite), and the V-cycle
+    // is no SPD preconditioner for CG.
+    bool coarsest_indefinite() const;
     index_t dofs(int level) const;
     const SparseRows& tentative(int level) const;      // level -> level + 1, before smoothing
     SparseRows prolongator(int level) const;           // as apply() uses it (float values)
