@@ -5,8 +5,10 @@
 // are freed again afterwards) and recomputes the Galerkin operators,
 // smoothers and the coarsest factorisation: at every
 // amg_refresh_interval-th K, or (0) lagged while CG's iterations stay within
-// 1.5x + 2 of those after the last refresh and the coefficients (the step
-// size) are unchanged. The finest level's products are the LinearSystem's
+// 1.5x + 2 of those after the last refresh, the coefficients (the step
+// size) are unchanged and the coarsest level was definite (an indefinite
+// one is reported as negative curvature: Preconditioner::indefinite). The
+// finest level's products are the LinearSystem's
 // matrix-free ones (the per-edge K on the back-end's executor). A
 // whole-vector preconditioner: one V-cycle per CG iteration. On the host,
 // on the back-end's executor (Backend::executor()) when it has one.

@@ -4,8 +4,8 @@
 // shape. build() forms the aggregates (greedy, on the matrix's block graph)
 // and the prolongators P = (I - w D^-1 A) P_tent once; refresh() recomputes
 // the Galerkin operators R A P, the smoothers (Chebyshev in D^-1 A or l1
-// block-Jacobi) and the coarsest factorisation (CHOLMOD, its analysis
-// reused) for a new A of the same pattern; apply() runs one symmetric
+// block-Jacobi) and the coarsest level's dense LDL^T (its factor in float;
+// core/src/amg/coarse_ldlt.hpp) for a new A of the same pattern; apply() runs one symmetric
 // V-cycle (the smoothers are symmetric and only products and axpys), the finest level's
 // products through a caller's function (the matrix-free per-edge K). On the
 // host: on an executor's threads when set_executor() gives one (the vector
