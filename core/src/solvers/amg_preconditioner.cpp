@@ -37,7 +37,9 @@ public:
         const int interval = s_.scene.solver.amg_refresh_interval;
         const std::array<double, 3> c{A.c_m(), A.c_k(), A.c_b()};
         ++age_;
-        const bool due = interval > 0 ? age_ >= interval : stale_ || c != c_;
+        // An indefinite coarsest level is refreshed at the next set-up under
+        // any interval: that set-up is the definite K the step falls back to.
+        const bool due = amg_.coarsest_indefinite() || (interval > 0 ? age_ >= interval : stale_ || c != c_);
         if (built_ && !due) return;
         matrix_.assemble(A);
         if (!built_) {
@@ -53,9 +55,7 @@ public:
         built_ = true;
         c_ = c;
         age_ = 0;
-        // an indefinite A: refreshed at the next set-up (the definite K the
-        // step falls back to), not lagged
-        stale_ = amg_.coarsest_indefinite();
+        stale_ = false;
         fresh_iterations_ = -1;
     }
 
