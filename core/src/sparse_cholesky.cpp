@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 #include "edgefem/core/error.hpp"
@@ -88,7 +87,8 @@ struct SparseCholesky::Impl {
         cholmod_free_factor(&order, &c);
         std::vector<index_t> position(std::size_t(A.n));
         for (index_t k = 0; k < A.n; ++k) position[std::size_t(perm[std::size_t(k)])] = k;
-        // the permuted entries, column by column (counting sort), rows sorted
+        // P A P^T's lower entries: column starts by counting, the entries in
+        // (column, row) order by one sort
         permuted.n = A.n;
         permuted.col_start.assign(std::size_t(A.n) + 1, 0);
         const std::size_t nnz = A.row.size();

@@ -35,7 +35,7 @@ bool CoarseLdlt::factor(const SparseRows& A) {
     const Eigen::VectorXd moved = ldlt.transpositionsP() * iota;
     perm_.resize(n_);
     for (std::size_t k = 0; k < n_; ++k) perm_[k] = int(moved[Eigen::Index(k)]);
-    const Eigen::MatrixXd L = ldlt.matrixL();
+    const Eigen::MatrixXd& L = ldlt.matrixLDLT();  // L strictly below the diagonal (unit diagonal implied)
     d_.resize(n_);
     negative_ = false;
     for (std::size_t i = 0; i < n_; ++i) {

@@ -25,7 +25,6 @@ public:
     // x = A^-1 b (n each; x may not alias b).
     void solve(const double* b, double* x) const;
     std::size_t bytes() const;
-    std::size_t dofs() const { return n_; }
     // Whether D has a negative entry: the operator is indefinite.
     bool indefinite() const { return negative_; }
 
