@@ -321,6 +321,23 @@ TEST(SmoothedAggregation, AnIndefiniteOperatorFactorsAtTheCoarsestLevel) {
     EXPECT_NEAR(dot(r2, z1), dot(b, z2), 1e-10 * std::sqrt(dot(b, b) * dot(z2, z2) + dot(r2, r2) * dot(z1, z1)));
 }
 
+// A share of nonzeros outside [0, 1] (or NaN) for dense_coarsest is an
+// error that names it, before anything is built.
+TEST(SmoothedAggregation, DenseCoarsestOutsideZeroToOneIsAnError) {
+    const BoxSystem sys = box_system(4, 2, 2, 2);
+    for (const double bad : {-0.1, 1.5, std::nan("")}) {
+        AmgSettings settings;
+        settings.dense_coarsest = bad;
+        SmoothedAggregation amg;
+        try {
+            amg.build(sys.A, sys.mesh.X, sys.free_dof, settings);
+            ADD_FAILURE() << "no error for " << bad;
+        } catch (const InvalidArgument& e) {
+            EXPECT_NE(std::string(e.what()).find("dense_coarsest in [0, 1]"), std::string::npos) << e.what();
+        }
+    }
+}
+
 // On an executor's threads the V-cycle and a smoother application give
 // bitwise what they give serially (every pass splits into fixed blocks; the
 // P^T held instead of P adds each coarse entry's terms in P's scatter's
