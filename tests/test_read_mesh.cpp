@@ -349,6 +349,9 @@ TEST(read_mesh_errors, EditedVariants) {
     expect_mesh_error([&] { read_vega(p); }, {"nan.veg:8:", "vertex 4 (numbered 5 in the file)", "non-finite"});
     p = write("extra.veg", replace_once(veg, "6 0.05 0.05 -0.1\n", "6 0.05 0.05 -0.1\n7 1 1 1\n"));
     expect_mesh_error([&] { read_vega(p); }, {"extra.veg:10:", "more lines than the section's count"});
+    // found by the fuzzer: a constants line of separators only (read f[0] of nothing)
+    p = write("blank-material.veg", replace_once(veg, "ENU, 1000, 10000000, 0.45", " ,"));
+    expect_mesh_error([&] { read_vega(p); }, {"blank-material.veg:20:", "expected 'ENU, density, E, nu', got no values"});
     p = write("count.veg", replace_once(veg, "3 4 0\n", "3 8 0\n"));
     expect_mesh_error([&] { read_vega(p); }, {"count.veg:14:", "nodes per element must be 4"});
 

@@ -93,6 +93,8 @@ void read_material(detail::TextReader& r, VegaRegions& v, ReadReport* report) {
     if (v.materials.count(name)) r.fail("a second *MATERIAL '" + detail::quote(name) + "'");
     r.require_line("the constants of material '" + detail::quote(name) + "' (ENU, density, E, nu)");
     const auto f = fields(r.line());
+    if (f.empty())  // a line of separators only (" ,")
+        r.fail("material '" + detail::quote(name) + "': expected 'ENU, density, E, nu', got no values");
     if (!detail::iequals(f[0], "ENU"))
         r.fail("material type '" + detail::quote(f[0]) + "' of material '" + detail::quote(name) +
                "' is not supported (only ENU: density, Young's modulus, Poisson ratio)");
