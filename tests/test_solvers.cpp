@@ -526,8 +526,9 @@ bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
 }  // namespace
 
 // auto (the default): block-Jacobi, bitwise, while its solves stay within
-// the threshold; past it, AMG from the next step on (far fewer iterations,
-// the same solution to the solver's tolerance); never with a fixed budget.
+// the threshold; the solve that goes past it goes on under AMG from its
+// iterate, and AMG stays (far fewer iterations, the same solution to the
+// solver's tolerance); never with a fixed budget.
 TEST(Solvers, AutoPreconditionerSwitchesToAmgPastItsThreshold) {
     EXPECT_EQ(SolverSettings{}.preconditioner, PreconditionerKind::Auto);
     Scene s = test::clamped_box_scene(24, 6, 6, 1e6);
@@ -537,13 +538,18 @@ TEST(Solvers, AutoPreconditionerSwitchesToAmgPastItsThreshold) {
     const AutoRun bj = run_steps(s, PreconditionerKind::BlockJacobi, 4);
     const AutoRun amg = run_steps(s, PreconditionerKind::Amg, 4);
     ASSERT_GT(bj.its[0], 50);
+    ASSERT_LT(2 * amg.its[0], bj.its[0]);
     // Within the threshold: block-Jacobi's bits.
     const AutoRun below = run_steps(s, PreconditionerKind::Auto, 4, 100000);
     EXPECT_TRUE(same_bits(below.u, bj.u));
     EXPECT_EQ(below.its, bj.its);
-    // Past it after the first step: that step is block-Jacobi's, the others AMG's.
-    const AutoRun past = run_steps(s, PreconditionerKind::Auto, 4, bj.its[0] - 1);
-    EXPECT_EQ(past.its[0], bj.its[0]);
+    // Past it in the first solve: its first `threshold` iterations are
+    // block-Jacobi's, the rest (from that iterate) and every later solve AMG's.
+    const int threshold = bj.its[0] / 2;
+    const AutoRun past = run_steps(s, PreconditionerKind::Auto, 4, threshold);
+    EXPECT_GT(past.its[0], threshold);
+    EXPECT_LE(past.its[0], threshold + amg.its[0] + 2);
+    EXPECT_LT(past.its[0], bj.its[0]);
     for (int k = 1; k < 4; ++k) {
         EXPECT_LE(past.its[std::size_t(k)], amg.its[std::size_t(k)] + 2) << "step " << k;
         EXPECT_LT(4 * past.its[std::size_t(k)], bj.its[std::size_t(k)]) << "step " << k;
@@ -557,6 +563,28 @@ TEST(Solvers, AutoPreconditionerSwitchesToAmgPastItsThreshold) {
     // A fixed CG budget keeps block-Jacobi whatever the threshold.
     s.solver.cg_fixed_iterations = 30;
     EXPECT_TRUE(same_bits(run_steps(s, PreconditionerKind::Auto, 3, 1).u, run_steps(s, PreconditionerKind::BlockJacobi, 3).u));
+}
+
+// A step too large for block-Jacobi within cg_max_iterations fails under
+// block-Jacobi and succeeds under auto (at the default threshold), whose
+// solve changes to AMG part way, to AMG's solution.
+TEST(Solvers, AutoPreconditionerCompletesASolveBlockJacobiCannot) {
+    Scene s = test::clamped_box_scene(24, 6, 6, 1e6);
+    s.dt = 10e-3;
+    s.solver.cg_tolerance = 1e-10;
+    s.solver.cg_max_iterations = 100;
+    EXPECT_THROW(run_steps(s, PreconditionerKind::BlockJacobi, 1), SimulationError);
+    const AutoRun amg = run_steps(s, PreconditionerKind::Amg, 2);
+    const AutoRun a = run_steps(s, PreconditionerKind::Auto, 2, SolverSettings{}.auto_amg_iterations);
+    EXPECT_GT(a.its[0], SolverSettings{}.auto_amg_iterations);
+    EXPECT_LE(a.its[0], 100);
+    EXPECT_LE(a.its[1], amg.its[1] + 2);
+    double diff = 0, norm = 0;
+    for (std::size_t i = 0; i < amg.u.size(); ++i) {
+        diff += (a.u[i] - amg.u[i]) * (a.u[i] - amg.u[i]);
+        norm += amg.u[i] * amg.u[i];
+    }
+    EXPECT_LT(std::sqrt(diff / norm), 1e-8);
 }
 
 TEST(Solvers, DirectSolverAnalysesThePatternOnce) {

@@ -1,7 +1,9 @@
 // The automatic choice (SolverSettings::preconditioner Auto, the default):
 // block-Jacobi until one of its solves needs more than
-// SolverSettings::auto_amg_iterations CG iterations, then AMG from the next
-// set-up to the end of the run. Where block-Jacobi needs few iterations (small
+// SolverSettings::auto_amg_iterations CG iterations; that solve goes on from
+// its iterate under AMG (set up on the same K), and AMG stays to the end of
+// the run. So a step too large for block-Jacobi's iteration limit does not
+// fail on it. Where block-Jacobi needs few iterations (small
 // steps, soft or small meshes) an iteration of it is ~16-19x cheaper than an
 // AMG one and it wins; past the threshold AMG's 7-17 iterations win
 // (docs/solvers.md, "Which preconditioner by default"). The switch depends on
@@ -22,25 +24,20 @@ public:
           allowed_(state.scene.solver.cg_fixed_iterations == 0 &&
                    state.backend->memory().space() == MemorySpace::Host) {}
 
-    void setup(LinearSystem<S>& A) override {
-        if (due_ && !amg_) {
-            active_ = make_amg(s_);
-            amg_ = true;
-        }
+    void setup(LinearSystem<S>& A) override { active_->setup(A); }
+    void solved(int iterations) override { active_->solved(iterations); }
+    int switch_after() const override { return amg_ || !allowed_ ? 0 : s_.scene.solver.auto_amg_iterations; }
+    void switch_now(LinearSystem<S>& A) override {
+        active_ = make_amg(s_);
+        amg_ = true;
         active_->setup(A);
-    }
-    void solved(int iterations) override {
-        active_->solved(iterations);
-        if (!amg_ && allowed_ && iterations > s_.scene.solver.auto_amg_iterations) due_ = true;
     }
     void save(CheckpointWriter& w) const override {
         w.value(amg_);
-        w.value(due_);
         active_->save(w);
     }
     void load(CheckpointReader& r, LinearSystem<S>& A) override {
         const bool amg = r.value<bool>("auto preconditioner: AMG active");
-        due_ = r.value<bool>("auto preconditioner: AMG due");
         if (amg && !allowed_) r.fail("auto preconditioner", "AMG active where it cannot run");
         if (amg != amg_) active_ = amg ? make_amg(s_) : make_block_jacobi(s_);
         amg_ = amg;
@@ -56,7 +53,6 @@ private:
     std::unique_ptr<Preconditioner<S>> active_;
     const bool allowed_;
     bool amg_ = false;  // AMG has taken over
-    bool due_ = false;  // a block-Jacobi solve went past the threshold: AMG at the next set-up
 };
 
 }  // namespace

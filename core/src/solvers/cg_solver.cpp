@@ -26,10 +26,22 @@ public:
                    int fixed_iterations) override {
         const double s = solve_scale(A.c_m(), b, x);
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, true);
-        CgResult res = s_.kernels.cg(A, *precond_, s_.free_dof.data(), b.data(), x.data(), s_.n(),
-                                     {tolerance, s_.scene.solver.cg_max_iterations, fixed_iterations}, work_);
+        const int max_it = s_.scene.solver.cg_max_iterations;
+        const int after = fixed_iterations == 0 ? precond_->switch_after() : 0;
+        const bool may_switch = after > 0 && after < max_it;
+        CgResult res = run(A, b, x, tolerance, may_switch ? after : max_it, fixed_iterations);
+        int last = res.iterations;  // under the preconditioner active at the end
+        if (may_switch && !res.converged && !res.negative_curvature) {
+            // Warm-started from the iterate reached: the residual is relative to
+            // the same right side, so the tolerance means what it meant.
+            precond_->switch_now(A);
+            const int before = res.iterations;
+            res = run(A, b, x, tolerance, max_it - before, 0);
+            last = res.iterations;
+            res.iterations += before;
+        }
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, false);
-        precond_->solved(res.iterations);
+        precond_->solved(last);
         if (precond_->indefinite()) {  // see Preconditioner::indefinite
             res.negative_curvature = true;
             res.converged = false;
@@ -38,6 +50,12 @@ public:
     }
 
 private:
+    CgResult run(LinearSystem<S>& A, BackendVector<double>& b, BackendVector<double>& x, double tolerance, int max_it,
+                 int fixed_iterations) {
+        return s_.kernels.cg(A, *precond_, s_.free_dof.data(), b.data(), x.data(), s_.n(),
+                             {tolerance, max_it, fixed_iterations}, work_);
+    }
+
     // A power of two s with b / s and the mass part of A x / s near 1 when
     // they are extreme, else 1. CG's dot products square its vectors: for a
     // body whose motion has decayed to 1e-150 m they underflow into

@@ -30,6 +30,12 @@ public:
     // p.Ap = r.A^-1 r, positive), so the solve reports it, as the direct
     // solver's LDL^T does, and the step falls back to the definite K.
     virtual bool indefinite() const { return false; }
+    // A preconditioner that gives way to a stronger one part way through a
+    // solve ("auto"): the CG iterations after which a solve that has not
+    // converged changes preconditioner (0: never), and the change itself,
+    // set up on the A being solved. The solve goes on from its iterate.
+    virtual int switch_after() const { return 0; }
+    virtual void switch_now(LinearSystem<S>& /*A*/) {}
 };
 
 // The scene's SolverSettings::preconditioner.

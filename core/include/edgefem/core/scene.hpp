@@ -57,7 +57,7 @@ enum class LinearSolver {
 enum class PreconditionerKind {
     BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap, iterations grow with dt, stiffness and mesh size
     Amg,          // smoothed-aggregation multigrid on the rigid-body modes: set-up per K, few iterations
-    Auto,         // block-Jacobi, then AMG once a solve needs more than auto_amg_iterations (the default)
+    Auto,         // block-Jacobi, AMG from the solve that needs more than auto_amg_iterations on (the default)
 };
 
 struct SolverSettings {
