@@ -237,7 +237,7 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
     const std::shared_ptr<const Executor> ex = g_threads > 1 ? make_executor(ExecutorKind::Pool, g_threads) : nullptr;
     std::printf("\n## step: semi-implicit, CG to 1e-6, %s; medians of %d alternating steps (after one)\n\n"
                 "AMG: its Galerkin operators refreshed at every K (`amg_refresh_interval` 1) or lagged (0, the "
-                "default: refreshed when the iterations grow 1.5x).\n\n",
+                "default: refreshed when the iterations per decade grow 1.5x).\n\n",
                 ex ? ("pool x" + std::to_string(g_threads)).c_str() : "serial", rounds);
     std::printf("| mesh | dofs | Y Pa | dt ms | BJ its | AMG its (every K / lagged) | BJ ms/step | AMG ms/step (every K / lagged) | "
                 "lagged AMG / BJ | direct ms/step | direct / BJ | BJ set-up ms | AMG set-up ms (every K / lagged) | "

@@ -575,6 +575,7 @@ PYBIND11_MODULE(_edgefem, m) {
         .def_readonly("solve_ms", &StepStats::solve_ms)
         .def_readonly("solver_iterations", &StepStats::solver_iterations)
         .def_readonly("symbolic_analyses", &StepStats::symbolic_analyses)
+        .def_readonly("preconditioner_refreshes", &StepStats::preconditioner_refreshes)
         .def_readonly("newton_iterations", &StepStats::newton_iterations)
         .def_readonly("residual", &StepStats::residual)
         .def_readonly("negative_curvature", &StepStats::negative_curvature)

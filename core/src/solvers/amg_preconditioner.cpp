@@ -4,15 +4,18 @@
 // a refresh assembles A into its fixed pattern (SystemMatrix, whose values
 // are freed again afterwards) and recomputes the Galerkin operators,
 // smoothers and the coarsest factorisation: at every
-// amg_refresh_interval-th K, or (0) lagged while CG's iterations stay within
-// 1.5x + 2 of those after the last refresh, the coefficients (the step
-// size) are unchanged and the coarsest level was definite (an indefinite
+// amg_refresh_interval-th K, or (0) lagged while CG's iterations per decade
+// of residual reduction stay within 1.5x (+ 2 iterations) of those after
+// the last refresh, the coefficients (the step size) are unchanged and the
+// coarsest level was definite (an indefinite
 // one is reported as negative curvature: Preconditioner::indefinite). The
 // finest level's products are the LinearSystem's
 // matrix-free ones (the per-edge K on the back-end's executor). A
 // whole-vector preconditioner: one V-cycle per CG iteration. On the host,
 // on the back-end's executor (Backend::executor()) when it has one.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 
 #include "edgefem/core/smoothed_aggregation.hpp"
@@ -52,18 +55,27 @@ public:
             refreshed_at_.record(s_, A);
         }
         matrix_.release();  // assembled again at the next refresh
+        ++refreshes_;
         built_ = true;
         c_ = c;
         age_ = 0;
         stale_ = false;
-        fresh_iterations_ = -1;
+        fresh_rate_ = -1;
     }
 
     bool indefinite() const override { return amg_.coarsest_indefinite(); }
+    int refreshes() const override { return refreshes_; }
 
-    void solved(int iterations) override {
-        if (fresh_iterations_ < 0) fresh_iterations_ = iterations;
-        else if (iterations > 1.5 * fresh_iterations_ + 2) stale_ = true;
+    // Per decade of the residual reduction reached, so that Newton's
+    // solves, whose tolerances change from one iteration to the next (the
+    // forcing term), do not look stale whenever one asks for more digits
+    // than the solve after the refresh did (which refreshed at nearly every
+    // Newton iteration). A semi-implicit step's solves all ask for the same
+    // tolerance: for them it is the iteration count as before.
+    void solved(int iterations, double residual) override {
+        const double decades = std::max(1.0, -std::log10(std::max(residual, 1e-300)));
+        if (fresh_rate_ < 0) fresh_rate_ = iterations / decades;
+        else if (iterations > 1.5 * fresh_rate_ * decades + 2) stale_ = true;
     }
 
     // The hierarchy and the last refresh are rebuilt from the points they
@@ -73,7 +85,7 @@ public:
         w.value(c_);
         w.value(age_);
         w.value(stale_);
-        w.value(fresh_iterations_);
+        w.value(fresh_rate_);
         built_at_.save(w);
         refreshed_at_.save(w);
     }
@@ -82,7 +94,7 @@ public:
         c_ = r.value<std::array<double, 3>>("AMG coefficients");
         age_ = r.value<int>("AMG age");
         stale_ = r.value<bool>("AMG stale");
-        fresh_iterations_ = r.value<int>("AMG iterations");
+        fresh_rate_ = r.value<double>("AMG iterations per decade");
         built_at_.load(r, s_.n());
         refreshed_at_.load(r, s_.n());
         if (built_ != built_at_.valid) r.fail("AMG", "built without its point");
@@ -127,7 +139,8 @@ private:
     std::array<double, 3> c_{};  // c_m, c_k, c_b at the last refresh
     int age_ = 0;                // set-ups since the last refresh
     bool stale_ = false;         // the iterations grew: refresh at the next K
-    int fresh_iterations_ = -1;  // CG's iterations right after the last refresh
+    double fresh_rate_ = -1;     // CG's iterations per decade right after the last refresh
+    int refreshes_ = 0;          // builds and refreshes so far
     TangentPoint<S> built_at_, refreshed_at_;  // where the hierarchy was built and last refreshed (checkpoints)
 };
 

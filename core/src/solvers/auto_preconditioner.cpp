@@ -25,7 +25,7 @@ public:
                    state.backend->memory().space() == MemorySpace::Host) {}
 
     void setup(LinearSystem<S>& A) override { active_->setup(A); }
-    void solved(int iterations) override { active_->solved(iterations); }
+    void solved(int iterations, double residual) override { active_->solved(iterations, residual); }
     int switch_after() const override { return amg_ || !allowed_ ? 0 : s_.scene.solver.auto_amg_iterations; }
     void switch_now(LinearSystem<S>& A) override {
         active_ = make_amg(s_);
@@ -45,6 +45,7 @@ public:
     }
     std::size_t bytes() const override { return active_->bytes(); }
     bool indefinite() const override { return active_->indefinite(); }
+    int refreshes() const override { return active_->refreshes(); }
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override { active_->apply(lo, hi, r, z); }
     bool whole_vector() const override { return active_->whole_vector(); }
 

@@ -18,6 +18,7 @@ public:
         : s_(state), precond_(make_preconditioner(state)), work_(state.backend->memory()) {}
 
     bool reusable() const override { return true; }
+    int refreshes() const override { return precond_->refreshes(); }
     void setup(LinearSystem<S>& A) override { precond_->setup(A); }
     void save(CheckpointWriter& w) const override { precond_->save(w); }
     void load(CheckpointReader& r, LinearSystem<S>& A) override { precond_->load(r, A); }
@@ -41,7 +42,7 @@ public:
             res.iterations += before;
         }
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, false);
-        precond_->solved(last);
+        precond_->solved(last, res.residual);
         if (precond_->indefinite()) {  // see Preconditioner::indefinite
             res.negative_curvature = true;
             res.converged = false;

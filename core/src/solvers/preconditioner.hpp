@@ -15,9 +15,9 @@ template <class S>
 class Preconditioner : public CgPreconditioner {
 public:
     virtual void setup(LinearSystem<S>& A) = 0;
-    // The iterations of the solve it just preconditioned (a lagged set-up
-    // decides from them when to refresh).
-    virtual void solved(int /*iterations*/) {}
+    // The solve it just preconditioned: its iterations and the relative
+    // residual reached (a lagged set-up decides from them when to refresh).
+    virtual void solved(int /*iterations*/, double /*residual*/) {}
     // The set-up that may outlive a step, for a checkpoint; load() rebuilds
     // it (A: the system it preconditions, its coefficients changed).
     virtual void save(CheckpointWriter& /*w*/) const {}
@@ -30,6 +30,9 @@ public:
     // p.Ap = r.A^-1 r, positive), so the solve reports it, as the direct
     // solver's LDL^T does, and the step falls back to the definite K.
     virtual bool indefinite() const { return false; }
+    // Set-ups that recomputed its operators so far (StepStats::
+    // preconditioner_refreshes).
+    virtual int refreshes() const { return 0; }
     // A preconditioner that gives way to a stronger one part way through a
     // solve ("auto"): the CG iterations after which a solve that has not
     // converged changes preconditioner (0: never), and the change itself,

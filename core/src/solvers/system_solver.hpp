@@ -19,6 +19,9 @@ public:
     virtual bool reusable() const = 0;
     // Symbolic analyses done so far (the direct solver's; 0 for CG).
     virtual int analyses() const { return 0; }
+    // Preconditioner set-ups that recomputed its operators so far (the AMG's
+    // builds and refreshes; 0 for the others).
+    virtual int refreshes() const { return 0; }
     // For A with its K just built (preconditioner, factorisation).
     virtual void setup(LinearSystem<S>& A) = 0;
     // The set-up that may outlive a step, for a checkpoint (the

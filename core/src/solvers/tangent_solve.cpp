@@ -24,6 +24,7 @@ template <class S>
 CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0,
                                      double tolerance, bool definite, bool reuse_stiffness, int fixed_iterations) {
     auto t0 = Clock::now();
+    const int refreshes = solver_->refreshes();
     reuse_stiffness = reuse_stiffness && solver_->reusable();
     system_.set(c_m, c_k, c_b, K0, definite);
     if (!reuse_stiffness) {
@@ -38,6 +39,7 @@ CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const E
     const CgResult res = solver_->solve(system_, s_.b, s_.x, tolerance, fixed_iterations);
     s_.stats.solve_ms += ms_since(t0);
     s_.stats.solver_iterations += res.iterations;
+    s_.stats.preconditioner_refreshes += solver_->refreshes() - refreshes;  // set-up and solve (auto switches in it)
     return res;
 }
 

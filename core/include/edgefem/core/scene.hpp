@@ -69,8 +69,9 @@ struct SolverSettings {
     int auto_amg_iterations = 60;
     // AMG: when its Galerkin operators and smoothers follow a new K (the
     // fine level's products are always the current K's). 0 (default): lagged
-    // while CG's iterations stay within 1.5x (+ 2) of those right after the
-    // last refresh, and on every change of the step size; N >= 1: every N-th
+    // while CG's iterations per decade of residual reduction stay within
+    // 1.5x (+ 2 iterations) of the solve's right after the last refresh, and
+    // on every change of the step size; N >= 1: every N-th
     // K (1: every K). docs/solvers.md has the measurements.
     int amg_refresh_interval = 0;
     AmgSettings amg;  // the hierarchy and smoother (amg_settings.hpp); C++ only

@@ -37,6 +37,7 @@ struct StepStats {
     double solve_ms = 0;      // linear solves
     int solver_iterations = 0;  // CG iterations (summed over Newton iterations)
     int symbolic_analyses = 0;  // direct solver: symbolic analyses done in the step (1 in the first, then 0)
+    int preconditioner_refreshes = 0;  // AMG: hierarchy builds and refreshes of its operators in the step
     int newton_iterations = 0;  // Implicit / static
     bool newton_round_off = false;  // Newton stopped at its round-off floor above newton_tolerance
     double residual = 0;        // final relative residual of the last solve
