@@ -7,7 +7,27 @@
 //              x = min, released from a 90-degree twist (linear in x) at rest;
 //  bunny       bunny-4k (a generated box of the same size without
 //              ../shared/meshes), Y = 5e4, nu = 0.4, the lowest 5% of its
-//              height fixed, released from rest under gravity -y.
+//              height fixed, released from rest under gravity -y;
+//  slender     box 48x3x3 of 5 mm cells (0.24 x 0.015 m, 2592 tets), Y = 1e7,
+//              nu = 0.45 (stiff rubber), clamped at x = min, released from
+//              rest under gravity -z;
+//  press       bunny-4k as above, Y = 5e4, nu = 0.49 (nearly
+//              incompressible, like soft tissue), the lowest 5 % fixed, the
+//              highest 10 % pressed down by 10 % of the height as by a flat
+//              tool, smoothly (s(t) = (1 - cos(pi t / 0.3 s)) / 2, keyframes
+//              every 10 ms), then held; no gravity;
+//  shake       box 48x3x3 of 5 mm cells (2592 tets), Y = 1e6, nu = 0.45,
+//              its x = min face moved 20 mm in z in 0.1 s (the same smooth
+//              curve) and held: it swings freely after; no gravity.
+// The last three are where the explicit stable step is far below the step
+// the motion needs: a fine, thin or nearly incompressible body, whose
+// fastest (pressure) wave crosses a cell in microseconds, moved slowly or
+// bending in a few Hz. They separate three cases: released at once
+// (slender), the second bending mode swings with a few % of the amplitude
+// and a step too long for it cannot follow; driven slowly (press), the
+// motion is nearly static and first-order backward Euler at a long step is
+// as accurate as anything; shaken and then free (shake), the first mode
+// swings undamped: the case the implicit second-order integrators are for.
 //
 // Each scene has a reference trajectory: the trapezoidal rule (Newmark beta
 // = 1/4, gamma = 1/2, second order) solved by Newton (relative tolerance
@@ -55,8 +75,9 @@ struct AccScene {
     Scene scene;                 // integrator / dt / solver set per configuration
     std::vector<double> u0;      // initial displacement (empty: rest)
     double duration = 0;         // simulated seconds
-    int samples = 0;             // sample times duration * k / samples, k = 1..samples
+    int samples = 0;             // sample times duration * k / samples, k = 1..samples: every 50 ms
     double dt_ref = 0;
+    std::vector<double> explicit_dts;  // the stiff scenes' explicit and Verlet steps
 };
 
 struct Config {
@@ -108,7 +129,7 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
         a.scene.gravity = {0, 0, -9.81};
         a.scene.fixed = below(a.scene.mesh, 0, coord(a.scene.mesh, 0, false) + 1e-9);
         a.duration = 0.5 * span;
-        a.samples = 10;
+        a.samples = int(10 * span);
         a.dt_ref = 2e-5;
         out.push_back(std::move(a));
     }
@@ -128,7 +149,7 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
             b.u0[3 * v + 2] = std::sin(th) * y + std::cos(th) * z - z;
         }
         b.duration = 0.5 * span;
-        b.samples = 10;
+        b.samples = int(10 * span);
         b.dt_ref = 2e-5;
         out.push_back(std::move(b));
     }
@@ -143,9 +164,70 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
         const double y0 = coord(c.scene.mesh, 1, false), y1 = coord(c.scene.mesh, 1, true);
         c.scene.fixed = below(c.scene.mesh, 1, y0 + 0.05 * (y1 - y0));
         c.duration = 0.3 * span;
-        c.samples = 6;
+        c.samples = int(6 * span);
         c.dt_ref = 5e-5;
         out.push_back(std::move(c));
+    }
+    // Thin bodies clamped at x = min, released from rest under gravity -z.
+    auto clamped_under_gravity = [&](const char* name, const char* origin, Mesh mesh, Material mat) {
+        AccScene d;
+        d.name = name;
+        d.mesh_origin = origin;
+        d.scene.mesh = std::move(mesh);
+        d.scene.materials = mat;
+        d.scene.gravity = {0, 0, -9.81};
+        d.scene.fixed = below(d.scene.mesh, 0, coord(d.scene.mesh, 0, false) + 1e-9);
+        d.duration = 0.5 * span;
+        d.samples = int(10 * span);
+        d.dt_ref = 1e-4;
+        d.explicit_dts = {1e-5, 1.25e-5, 2e-5};
+        out.push_back(std::move(d));
+    };
+    if (only.empty() || only == "slender")
+        clamped_under_gravity("slender", "box 48x3x3, 5 mm", make_box(48, 3, 3, 0.005), Material{1e7, 0.45, 1000});
+    // Driven smoothly from rest by prescribed vertices: the fraction
+    // (1 - cos(pi t / T)) / 2 of their displacement up to T, then 1
+    // (keyframes every T / 30).
+    auto smooth_drive = [&](AccScene& d, const std::vector<index_t>& moved, std::array<double, 3> by, double T) {
+        for (index_t v : moved)
+            d.scene.prescribed.push_back({v, {d.scene.mesh.X[3 * v] + by[0], d.scene.mesh.X[3 * v + 1] + by[1],
+                                              d.scene.mesh.X[3 * v + 2] + by[2]}});
+        for (int k = 0; k <= 30; ++k)
+            d.scene.prescribed_keyframes.push_back({T * k / 30.0, 0.5 * (1 - std::cos(M_PI * k / 30.0))});
+        d.duration = 0.5 * span;
+        d.samples = int(10 * span);
+        d.dt_ref = 1e-4;
+    };
+    if (only.empty() || only == "press") {
+        AccScene d;
+        d.name = "press";
+        Mesh m = load_named_mesh(mesh_folder, "bunny-4k", &d.mesh_origin);
+        validate_mesh(m);
+        d.scene.mesh = std::move(m);
+        d.scene.materials = Material{5e4, 0.49, 1000};
+        const double y0 = coord(d.scene.mesh, 1, false), y1 = coord(d.scene.mesh, 1, true);
+        d.scene.fixed = below(d.scene.mesh, 1, y0 + 0.05 * (y1 - y0));
+        std::vector<index_t> top;
+        for (index_t v = 0; v < d.scene.mesh.num_vertices(); ++v)
+            if (d.scene.mesh.X[3 * v + 1] >= y1 - 0.1 * (y1 - y0)) top.push_back(v);
+        smooth_drive(d, top, {0, -0.1 * (y1 - y0), 0}, 0.3);
+        d.explicit_dts = {1e-5, 1.25e-5, 2e-5};
+        out.push_back(std::move(d));
+    }
+    // Swinging freely after a shake: the clamped face (x = min) moved 20 mm
+    // in z in 0.1 s, smoothly, then held; no gravity. A smooth 0.1 s move
+    // sets the first bending mode swinging and the second hardly at all, so
+    // the motion is slow next to the explicit step.
+    if (only.empty() || only == "shake") {
+        AccScene d;
+        d.name = "shake";
+        d.mesh_origin = "box 48x3x3, 5 mm";
+        d.scene.mesh = make_box(48, 3, 3, 0.005);
+        d.scene.materials = Material{1e6, 0.45, 1000};
+        const std::vector<index_t> face = below(d.scene.mesh, 0, coord(d.scene.mesh, 0, false) + 1e-9);
+        smooth_drive(d, face, {0, 0, 0.02}, 0.1);
+        d.explicit_dts = {2.5e-5, 4e-5, 5e-5};
+        out.push_back(std::move(d));
     }
     for (auto& s : out) {
         s.scene.count_inverted_tets = false;
@@ -154,7 +236,69 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
     return out;
 }
 
+void label(std::vector<Config>& cs) {
+    for (auto& c : cs) {
+        std::ostringstream os;
+        os << to_string(c.integrator) << " dt=" << c.dt;
+        if (!is_explicit(c.integrator)) {
+            if (c.cg_fixed)
+                os << " cg=" << c.cg_fixed << "it";
+            else if (c.cg_tol != 1e-6)
+                os << " cg=" << c.cg_tol;
+        }
+        if (c.single) os << " float";
+        if (c.model == ModelKind::SN) os << " SN";
+        if (c.definite) os << " definite";
+        if (c.method == Method::Tet) os << " per-tet";
+        if (c.direct) os << " direct";
+        c.label = os.str();
+    }
+}
+
+// The stiff scenes: explicit and Verlet around their stability limit
+// (AccScene::explicit_dts), the first-order implicit ones from 0.25 to 25 ms, the
+// second-order implicit ones from 2 to 50 ms. Every step divides the 50 ms
+// between samples (make_configs checks it).
+std::vector<Config> stiff_configs(const std::vector<double>& explicit_dts, bool quick) {
+    std::vector<Config> cs;
+    auto add = [&](Integrator in, double dt) {
+        Config c;
+        c.integrator = in;
+        c.dt = dt;
+        cs.push_back(c);
+    };
+    for (Integrator in : {Integrator::Explicit, Integrator::Verlet})
+        for (double dt : quick ? std::vector<double>{explicit_dts.front()} : explicit_dts) add(in, dt);
+    for (double dt : quick ? std::vector<double>{1e-3} : std::vector<double>{2.5e-4, 1e-3, 5e-3, 25e-3})
+        add(Integrator::SemiImplicit, dt);
+    if (!quick) add(Integrator::Implicit, 1e-3);
+    for (Integrator in : {Integrator::NewmarkLinear, Integrator::GeneralizedAlphaLinear, Integrator::Bdf2Linear})
+        for (double dt : quick ? std::vector<double>{5e-3} : std::vector<double>{2e-3, 5e-3, 10e-3, 25e-3, 50e-3}) add(in, dt);
+    if (!quick)
+        for (double dt : {5e-3, 10e-3}) add(Integrator::Newmark, dt);
+    label(cs);
+    return cs;
+}
+
+std::vector<Config> scene_configs(const AccScene& sc, bool quick);
+
+// Every configuration's dt divides the time between samples: a sample taken
+// at the step nearest its time, dt / 2 away, would add an error of the
+// order of v dt / 2 to every integrator alike (first order).
 std::vector<Config> make_configs(const AccScene& sc, bool quick) {
+    std::vector<Config> cs = scene_configs(sc, quick);
+    const double every = sc.duration / sc.samples;
+    for (const Config& c : cs) {
+        const double n = every / c.dt;
+        if (std::abs(n - std::round(n)) > 1e-9 * n)
+            throw Error("accuracy: " + sc.name + ": " + c.label + " does not divide the " + std::to_string(every) +
+                        " s between samples");
+    }
+    return cs;
+}
+
+std::vector<Config> scene_configs(const AccScene& sc, bool quick) {
+    if (!sc.explicit_dts.empty()) return stiff_configs(sc.explicit_dts, quick);
     std::vector<Config> cs;
     auto add = [&](Config c) { cs.push_back(c); };
     const bool bunny = sc.name == "bunny";
@@ -168,19 +312,19 @@ std::vector<Config> make_configs(const AccScene& sc, bool quick) {
     }
     // The first-order implicit ones from 0.1 ms: how far they are from 1 %
     // error (docs/dynamics.md, the targets).
-    for (double dt : quick ? std::vector<double>{1e-3, 4e-3} : std::vector<double>{1e-4, 5e-4, 1e-3, 2e-3, 4e-3, 1e-2}) {
+    for (double dt : quick ? std::vector<double>{1e-3, 5e-3} : std::vector<double>{1e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2}) {
         Config c;
         c.dt = dt;
         add(c);
     }
-    for (double dt : quick ? std::vector<double>{1e-3, 4e-3} : std::vector<double>{1e-4, 5e-4, 1e-3, 2e-3, 4e-3, 1e-2}) {
+    for (double dt : quick ? std::vector<double>{1e-3, 5e-3} : std::vector<double>{1e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2}) {
         Config c;
         c.integrator = Integrator::Implicit;
         c.dt = dt;
         add(c);
     }
     // The second-order integrators: explicit velocity Verlet at the
-    // explicit steps, the implicit ones (Newton and linearised) at 1-4 ms.
+    // explicit steps, the implicit ones (Newton and linearised) at 0.5-5 ms.
     for (double dt : bunny ? std::vector<double>{5e-5} : std::vector<double>{5e-5, 1e-4, 2e-4}) {
         if (quick && dt != (bunny ? 5e-5 : 1e-4)) continue;
         Config c;
@@ -190,7 +334,7 @@ std::vector<Config> make_configs(const AccScene& sc, bool quick) {
     }
     for (Integrator integ : {Integrator::Newmark, Integrator::NewmarkLinear, Integrator::GeneralizedAlpha,
                              Integrator::GeneralizedAlphaLinear, Integrator::Bdf2, Integrator::Bdf2Linear})
-        for (double dt : quick ? std::vector<double>{1e-3} : std::vector<double>{5e-4, 1e-3, 2e-3, 4e-3}) {
+        for (double dt : quick ? std::vector<double>{1e-3} : std::vector<double>{5e-4, 1e-3, 2e-3, 5e-3}) {
             Config c;
             c.integrator = integ;
             c.dt = dt;
@@ -255,22 +399,7 @@ std::vector<Config> make_configs(const AccScene& sc, bool quick) {
         c.method = Method::Tet;
         add(c);
     }
-    for (auto& c : cs) {
-        std::ostringstream os;
-        os << to_string(c.integrator) << " dt=" << c.dt;
-        if (!is_explicit(c.integrator)) {
-            if (c.cg_fixed)
-                os << " cg=" << c.cg_fixed << "it";
-            else if (c.cg_tol != 1e-6)
-                os << " cg=" << c.cg_tol;
-        }
-        if (c.single) os << " float";
-        if (c.model == ModelKind::SN) os << " SN";
-        if (c.definite) os << " definite";
-        if (c.method == Method::Tet) os << " per-tet";
-        if (c.direct) os << " direct";
-        c.label = os.str();
-    }
+    label(cs);
     return cs;
 }
 
@@ -337,6 +466,11 @@ std::uint64_t scene_hash(const AccScene& sc, const Config& ref) {
     h = fnv1a(s.mesh.tets.data(), s.mesh.tets.size() * sizeof(index_t), h);
     h = fnv1a(s.fixed.data(), s.fixed.size() * sizeof(index_t), h);
     h = fnv1a(sc.u0.data(), sc.u0.size() * sizeof(double), h);
+    for (const Prescribed& p : s.prescribed) {  // field by field: the struct has padding
+        h = fnv1a(&p.vertex, sizeof p.vertex, h);
+        h = fnv1a(p.target.data(), sizeof p.target, h);
+    }
+    h = fnv1a(s.prescribed_keyframes.data(), s.prescribed_keyframes.size() * sizeof(Keyframe), h);
     const Material& m = s.materials.fallback;
     const double nums[] = {m.young, m.poisson, m.density, s.gravity[0], s.gravity[1], s.gravity[2], sc.duration,
                            double(sc.samples), ref.dt, s.solver.newton_tolerance, s.solver.cg_tolerance, 4.0 /*format: newmark*/};
@@ -429,7 +563,7 @@ void add_accuracy_command(CLI::App& app) {
     cmd->add_option("--cache", opts->cache, "Folder for the cached reference trajectories (default: build/accuracy-cache)")
         ->check(non_empty_path());
     cmd->add_option("--json", opts->json, "Write the results as JSON to this file")->check(non_empty_path());
-    cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny"}));
+    cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny", "slender", "press", "shake"}));
     cmd->add_option("--mesh-dir", opts->mesh_dir,
                     "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)")
         ->check(non_empty_path());
