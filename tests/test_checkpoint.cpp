@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "cantilever.hpp"
@@ -42,12 +43,16 @@ struct Case {
 };
 
 // 8 x 3 x 3 cubes (144 vertices: the AMG gets one coarse level), clamped at
-// x = min, under gravity.
-Scene case_scene(const Case& c) {
+// x = min, under gravity. CG to 1e-8, or 1e-6 for a float model: its
+// operator's products carry round-off of ~1e-7 relative (the assembled A of
+// bdf2_linear_amg2 is symmetric to 2.6e-8 only), so whether CG gets below
+// that is luck (it stalled at 1e-5 after a change of the Galerkin
+// product's summation order of 1e-16).
+Scene case_scene(const Case& c, bool single = false) {
     Scene s = test::clamped_box_scene(8, 3, 3);
     s.integrator = c.integrator;
     s.dt = is_explicit(c.integrator) ? 5e-4 : 2e-3;
-    s.solver.cg_tolerance = 1e-8;
+    s.solver.cg_tolerance = single ? 1e-6 : 1e-8;
     s.solver.cg_max_iterations = 2000;
     if (c.damping_and_prescribed) {
         s.rayleigh_alpha = 0.5;
@@ -150,7 +155,7 @@ TYPED_TEST(CheckpointRestart, ReferenceBackendEveryIntegrator) {
     using S = TypeParam;
     test::TempDir dir("ckpt_ref");
     for (const Case& c : cases()) {
-        const Scene scene = case_scene(c);
+        const Scene scene = case_scene(c, std::is_same_v<S, float>);
         check_restart([&] { return std::make_unique<Simulator<S>>(scene); }, dir.file(c.name + ".ckpt"), c.name);
     }
 }
@@ -177,7 +182,7 @@ void check_cpu(const char* executor) {
     run.backend = executor;
     run.threads = 2;
     for (const Case& c : cpu_cases()) {
-        const Scene scene = case_scene(c);
+        const Scene scene = case_scene(c, std::is_same_v<S, float>);
         check_restart([&] { return make_simulator<S>(scene, run); }, dir.file(c.name + ".ckpt"),
                       std::string(executor) + " " + c.name);
     }

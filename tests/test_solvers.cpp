@@ -321,6 +321,47 @@ TEST(SmoothedAggregation, AnIndefiniteOperatorFactorsAtTheCoarsestLevel) {
     EXPECT_NEAR(dot(r2, z1), dot(b, z2), 1e-10 * std::sqrt(dot(b, b) * dot(z2, z2) + dot(r2, r2) * dot(z1, z1)));
 }
 
+// A refresh forms each coarse operator numerically, into a block pattern
+// kept from the first refresh (amg/galerkin_product.*): it is P^T A P of the
+// level above as Eigen's sparse product gives it, to the float rounding it
+// is stored in; after a refresh with other values on the same pattern, and
+// with an operator of a wider pattern (the pattern is found again).
+TEST(SmoothedAggregation, RefreshFormsTheGalerkinOperators) {
+    const BoxSystem sys = box_system(16, 8, 8, 10);
+    SmoothedAggregation amg;
+    amg.build(sys.A, sys.mesh.X, sys.free_dof, smoother_settings(AmgSmoother::Chebyshev, 2, 100));
+    ASSERT_GE(amg.levels(), 3);
+    const auto check = [&](const SparseRows& A, const char* what) {
+        SCOPED_TRACE(what);
+        amg.refresh(A);
+        SparseRows above = A;
+        for (int l = 1; l + 1 < amg.levels(); ++l) {
+            const SparseRows P = amg.prolongator(l - 1);
+            const SparseRows ref = SparseRows(P.transpose()) * above * P;
+            const SparseRows got = amg.matrix(l);
+            ASSERT_EQ(got.rows(), ref.rows());
+            EXPECT_LT(SparseRows(got - ref).norm(), 1e-6 * ref.norm()) << "level " << l;
+            above = ref;
+        }
+    };
+    check(sys.A, "the built operator");
+    SparseRows B = 0.7 * sys.A;
+    for (Eigen::Index i = 0; i < B.rows(); ++i)
+        if (sys.free_dof[std::size_t(i)]) B.coeffRef(i, i) *= 1.5;
+    check(B, "other values, the same pattern");
+    std::vector<Eigen::Triplet<double>> far;
+    const Eigen::Index n = B.rows(), step = 3 * 40;  // a vertex 40 on: no neighbour
+    for (Eigen::Index i = 0; i + step < n; i += 3)
+        if (sys.free_dof[std::size_t(i)] && sys.free_dof[std::size_t(i + step)]) {
+            const double c = 1e-3 * B.coeff(i, i);
+            far.emplace_back(i, i + step, c);
+            far.emplace_back(i + step, i, c);
+        }
+    SparseRows wide(n, n);
+    wide.setFromTriplets(far.begin(), far.end());
+    check(SparseRows(B + wide), "a wider pattern");
+}
+
 // A share of nonzeros outside [0, 1] (or NaN) for dense_coarsest is an
 // error that names it, before anything is built.
 TEST(SmoothedAggregation, DenseCoarsestOutsideZeroToOneIsAnError) {

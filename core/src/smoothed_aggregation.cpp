@@ -7,6 +7,7 @@
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/executor.hpp"
 #include "amg/coarse_ldlt.hpp"
+#include "amg/galerkin_product.hpp"
 
 namespace edgefem {
 
@@ -475,6 +476,7 @@ struct SmoothedAggregation::Impl {
         Eigen::MatrixXd B;     // near-nullspace, dofs x 6
         std::vector<double> Minv;  // the smoother's inverse blocks (D^-1, or l1 block-Jacobi's)
         double lambda = 1;     // Chebyshev: the largest eigenvalue of D^-1 A
+        amg::GalerkinProduct galerkin;  // level >= 1: forms its operator from the level above's at each refresh
         mutable Eigen::VectorXd x, b, r, d, t;  // V-cycle work
     };
     AmgSettings settings;
@@ -695,13 +697,16 @@ void SmoothedAggregation::refresh(const SparseRows& A) {
     Impl& m = *impl_;
     if (m.level.empty()) throw InvalidArgument("SmoothedAggregation::refresh: build() first");
     const SparseRows* Al = &A;
-    SparseRows Acur;  // the Galerkin operator of level l, in double while the next is formed
+    SparseRows Acur, Anext;  // the Galerkin operator of level l, in double while the next is formed
     for (std::size_t l = 0; l < m.level.size(); ++l) {
         Impl::Level& L = m.level[l];
         if (l > 0) {
-            const SparseRows P = Impl::prolongator(m.level[l - 1]);
-            SparseRows next = SparseRows(P.transpose()) * (*Al * P);
-            Acur = std::move(next);
+            const Impl::Level& up = m.level[l - 1];
+            BlockRows held;  // P, where the level above holds R = P^T
+            const BlockRows& P = up.P.rows > 0 ? up.P : (held = up.R.transposed());
+            const amg::BlockRowsView view{P.start.size() - 1, P.rb, P.cb, P.start.data(), P.col.data(), P.val.data()};
+            L.galerkin(*Al, view, std::size_t(P.cols / P.cb), Anext);
+            Acur.swap(Anext);
             Al = &Acur;
         }
         if (l + 1 < m.level.size()) {
@@ -760,7 +765,7 @@ std::size_t SmoothedAggregation::bytes() const {
     std::size_t b = 0;
     for (const auto& L : impl_->level)
         b += L.A.bytes() + L.P.bytes() + L.R.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
-             L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t);
+             L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t) + L.galerkin.bytes();
     b += impl_->coarse.bytes();
     return b;
 }

@@ -1,23 +1,22 @@
 #include "amg/coarse_ldlt.hpp"
 
-// Eigen's dense LDLT, inlined here, trips g++ 12's false
-// -Wmaybe-uninitialized with AVX-512 (GCC PR 105593); this file's only
-// dense kernel is that factorisation.
-#if defined(__GNUC__) && !defined(__clang__)  // clang (the fuzz builds) has no such warning
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+// Eigen's dense LDLT and blocked LLT, inlined here, trip g++ 12's false
+// -Wmaybe-uninitialized with AVX-512 (GCC PR 105593) at the point of
+// inlining, where a pragma does not reach: core/CMakeLists.txt turns that
+// warning off for this file only (its only dense kernels are these two).
 #include <Eigen/Dense>
 
 #include <cmath>
 
 namespace edgefem::amg {
 
-bool CoarseLdlt::factor(const SparseRows& A) {
-    n_ = std::size_t(A.rows());
-    const auto n = Eigen::Index(n_);
-    // Dense and symmetric from the lower triangle; a dof whose row is zero
-    // (a prolongator column without a mode: a constrained or degenerate
-    // aggregate) gets a unit diagonal.
+namespace {
+
+// Dense and symmetric from A's lower triangle; a dof whose row is zero (a
+// prolongator column without a mode: a constrained or degenerate
+// aggregate) gets a unit diagonal.
+Eigen::MatrixXd dense(const SparseRows& A) {
+    const Eigen::Index n = A.rows();
     Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
     for (Eigen::Index i = 0; i < n; ++i) {
         bool dead = true;
@@ -27,7 +26,44 @@ bool CoarseLdlt::factor(const SparseRows& A) {
         }
         if (dead) D(i, i) = 1.0;
     }
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(D);
+    return D;
+}
+
+}  // namespace
+
+bool CoarseLdlt::factor(const SparseRows& A) {
+    n_ = std::size_t(A.rows());
+    const auto n = Eigen::Index(n_);
+    // A definite operator (the usual case) by Cholesky, blocked (matrix
+    // products: 5-10x Eigen's LDLT, which is rank-1 updates), in place;
+    // L D L^T with L's unit diagonal and D the squares of the Cholesky
+    // factor's, no pivoting (none needed). An indefinite one (Cholesky
+    // meets a non-positive pivot) by the pivoted LDL^T.
+    {
+        Eigen::MatrixXd C = dense(A);
+        Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(C);
+        if (llt.info() == Eigen::Success) {
+            perm_.resize(n_);
+            d_.resize(n_);
+            negative_ = false;
+            for (std::size_t i = 0; i < n_; ++i) {
+                perm_[i] = int(i);
+                const double c = C(Eigen::Index(i), Eigen::Index(i));
+                d_[i] = c * c;
+                if (!std::isfinite(d_[i]) || d_[i] == 0) return false;
+            }
+            lower_.resize(n_ * (n_ - (n_ > 0)) / 2);
+            for (std::size_t i = 1; i < n_; ++i)
+                for (std::size_t j = 0; j < i; ++j) {
+                    const double l = C(Eigen::Index(i), Eigen::Index(j)) / C(Eigen::Index(j), Eigen::Index(j));
+                    if (!std::isfinite(l)) return false;
+                    lower_[i * (i - 1) / 2 + j] = float(l);
+                }
+            y_.resize(n_);
+            return true;
+        }
+    }
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(dense(A));  // C was overwritten
     if (ldlt.info() != Eigen::Success) return false;
     // P A P^T = L D L^T: (P b)_k = b[perm_[k]]
     Eigen::VectorXd iota(n);

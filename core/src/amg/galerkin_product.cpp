@@ -1,0 +1,143 @@
+#include "amg/galerkin_product.hpp"
+
+#include <algorithm>
+
+#include "edgefem/core/error.hpp"
+
+namespace edgefem::amg {
+
+namespace {
+
+// The blocks of A's block row I (their block columns), unsorted, each once.
+template <class F>
+void block_columns(const SparseRows& A, std::size_t I, int b, std::vector<int>& seen, F&& each) {
+    for (int r = 0; r < b; ++r)
+        for (SparseRows::InnerIterator it(A, Eigen::Index(I) * b + r); it; ++it) {
+            const int J = int(it.col() / b);
+            if (seen[std::size_t(J)] != int(I)) {
+                seen[std::size_t(J)] = int(I);
+                each(J);
+            }
+        }
+}
+
+}  // namespace
+
+void GalerkinProduct::find_pattern(const SparseRows& A, const BlockRowsView& P, std::size_t coarse_blocks) {
+    std::vector<std::vector<int>> rows(coarse_blocks);
+    std::vector<int> seen(P.block_rows, -1), mark(coarse_blocks, -1), ap;
+    for (std::size_t I = 0; I < P.block_rows; ++I) {
+        ap.clear();
+        block_columns(A, I, P.rb, seen, [&](int J) {
+            for (int k = P.start[J]; k < P.start[J + 1]; ++k)
+                if (const int c = P.col[k]; mark[std::size_t(c)] != int(I)) {
+                    mark[std::size_t(c)] = int(I);
+                    ap.push_back(c);
+                }
+        });
+        for (int k = P.start[I]; k < P.start[I + 1]; ++k) {
+            std::vector<int>& row = rows[std::size_t(P.col[k])];
+            row.insert(row.end(), ap.begin(), ap.end());
+        }
+    }
+    start_.assign(coarse_blocks + 1, 0);
+    col_.clear();
+    for (std::size_t a = 0; a < coarse_blocks; ++a) {
+        std::vector<int>& row = rows[a];
+        std::sort(row.begin(), row.end());
+        row.erase(std::unique(row.begin(), row.end()), row.end());
+        col_.insert(col_.end(), row.begin(), row.end());
+        start_[a + 1] = int(col_.size());
+        std::vector<int>().swap(row);
+    }
+    slot_.assign(coarse_blocks, -1);
+}
+
+bool GalerkinProduct::multiply(const SparseRows& A, const BlockRowsView& P, SparseRows& out) {
+    const int rb = P.rb, cb = P.cb;
+    const std::size_t w = std::size_t(rb) * std::size_t(cb);
+    const std::size_t nbc = start_.size() - 1;
+    // The result's scalar pattern: block row a's scalar rows each hold its
+    // blocks' cb columns in block order.
+    out.resize(Eigen::Index(nbc) * cb, Eigen::Index(nbc) * cb);
+    out.resizeNonZeros(Eigen::Index(col_.size()) * cb * cb);
+    int* outer = out.outerIndexPtr();
+    int* inner = out.innerIndexPtr();
+    double* val = out.valuePtr();
+    outer[0] = 0;
+    for (std::size_t a = 0; a < nbc; ++a)
+        for (int x = 0; x < cb; ++x) {
+            const std::size_t row = a * std::size_t(cb) + std::size_t(x);
+            int at = outer[row];
+            for (int k = start_[a]; k < start_[a + 1]; ++k)
+                for (int y = 0; y < cb; ++y) inner[at++] = col_[std::size_t(k)] * cb + y;
+            outer[row + 1] = at;
+        }
+    std::fill(val, val + out.nonZeros(), 0.0);
+    for (std::size_t I = 0; I < P.block_rows; ++I) {
+        // Row I of A P: rb x cb per coarse block, summed over A's entries.
+        cols_.clear();
+        for (int r = 0; r < rb; ++r)
+            for (SparseRows::InnerIterator it(A, Eigen::Index(I) * rb + r); it; ++it) {
+                const std::size_t J = std::size_t(it.col() / rb);
+                const int j = int(it.col() % rb);
+                const double v = it.value();
+                for (int k = P.start[J]; k < P.start[J + 1]; ++k) {
+                    const int c = P.col[k];
+                    if (slot_[std::size_t(c)] < 0) {
+                        slot_[std::size_t(c)] = int(cols_.size());
+                        cols_.push_back(c);
+                        if (scratch_.size() < cols_.size() * w) scratch_.resize(cols_.size() * w);
+                        std::fill_n(scratch_.begin() + std::ptrdiff_t((cols_.size() - 1) * w), w, 0.0);
+                    }
+                    double* s = scratch_.data() + std::size_t(slot_[std::size_t(c)]) * w + std::size_t(r) * std::size_t(cb);
+                    const float* p = P.val + std::size_t(k) * w + std::size_t(j) * std::size_t(cb);
+                    for (int y = 0; y < cb; ++y) s[y] += v * double(p[y]);
+                }
+            }
+        // P's blocks of row I, transposed, times it, into their blocks.
+        bool covered = true;
+        for (int kp = P.start[I]; kp < P.start[I + 1] && covered; ++kp) {
+            const std::size_t a = std::size_t(P.col[kp]);
+            const float* pa = P.val + std::size_t(kp) * w;  // pa[r cb + x] = P(I rb + r, a cb + x)
+            const int* first = col_.data() + start_[a];
+            const int* last = col_.data() + start_[a + 1];
+            for (std::size_t t = 0; t < cols_.size(); ++t) {
+                const int* pos = std::lower_bound(first, last, cols_[t]);
+                if (pos == last || *pos != cols_[t]) {
+                    covered = false;
+                    break;
+                }
+                const std::size_t k = std::size_t(pos - first);
+                const double* s = scratch_.data() + t * w;
+                for (int x = 0; x < cb; ++x) {
+                    double* o = val + outer[a * std::size_t(cb) + std::size_t(x)] + k * std::size_t(cb);
+                    for (int r = 0; r < rb; ++r) {
+                        const double pr = double(pa[std::size_t(r) * std::size_t(cb) + std::size_t(x)]);
+                        const double* sr = s + std::size_t(r) * std::size_t(cb);
+                        for (int y = 0; y < cb; ++y) o[y] += pr * sr[y];
+                    }
+                }
+            }
+        }
+        for (const int c : cols_) slot_[std::size_t(c)] = -1;
+        if (!covered) return false;
+    }
+    return true;
+}
+
+void GalerkinProduct::operator()(const SparseRows& A, const BlockRowsView& P, std::size_t coarse_blocks, SparseRows& out) {
+    if (A.rows() != A.cols() || A.rows() != Eigen::Index(P.block_rows) * P.rb)
+        throw InvalidArgument("GalerkinProduct: A is " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) +
+                              ", P has " + std::to_string(Eigen::Index(P.block_rows) * P.rb) + " rows");
+    if (start_.size() != coarse_blocks + 1) find_pattern(A, P, coarse_blocks);
+    if (multiply(A, P, out)) return;
+    find_pattern(A, P, coarse_blocks);  // A brought entries the pattern did not cover
+    if (!multiply(A, P, out)) throw Error("GalerkinProduct: the pattern found does not cover A P");
+}
+
+std::size_t GalerkinProduct::bytes() const {
+    return (start_.size() + col_.size() + slot_.size() + cols_.size()) * sizeof(int) + scratch_.size() * sizeof(double);
+}
+
+}  // namespace edgefem::amg

@@ -1,0 +1,51 @@
+// The AMG's Galerkin operator P^T A P, numerically, into a block pattern
+// found once. A refresh used to form it with Eigen's sparse products: four
+// temporaries allocated and freed per level, whose page faults, copies and
+// sorting made a refresh of bunny-4k's two levels cost 54-64 ms. Here the
+// pattern of P^T A P (in vertex blocks) is found at the first product and
+// kept (again only when A brings an entry it does not cover); each product
+// then runs row by row of A: its row of A P summed into a small scratch,
+// then P's blocks of that row times it added into the pattern's blocks.
+// One thread, a fixed order: the same bits for any executor.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "edgefem/core/smoothed_aggregation.hpp"
+
+namespace edgefem::amg {
+
+// A block-row matrix: `block_rows` rows of rb x cb blocks (row-major), the
+// blocks of row I at [start[I], start[I + 1]) with block columns col[k].
+struct BlockRowsView {
+    std::size_t block_rows = 0;
+    int rb = 1, cb = 1;
+    const int* start = nullptr;
+    const int* col = nullptr;
+    const float* val = nullptr;
+};
+
+class GalerkinProduct {
+public:
+    // P^T A P for A square (its rows and columns in blocks of P.rb, A's
+    // order P.block_rows * P.rb) and P with `coarse_blocks` block columns;
+    // every block of the result's pattern is stored whole (zeros included).
+    // `out` is overwritten (its storage reused where it is large enough).
+    void operator()(const SparseRows& A, const BlockRowsView& P, std::size_t coarse_blocks, SparseRows& out);
+    // Bytes it keeps between products (the pattern and the scratch).
+    std::size_t bytes() const;
+
+private:
+    void find_pattern(const SparseRows& A, const BlockRowsView& P, std::size_t coarse_blocks);
+    // The product into `out`; false when A has an entry whose block the
+    // pattern does not cover.
+    bool multiply(const SparseRows& A, const BlockRowsView& P, SparseRows& out);
+
+    std::vector<int> start_, col_;  // block pattern of P^T A P: block columns of each block row, sorted
+    std::vector<int> slot_;         // coarse block -> its place in the scratch row, -1 none
+    std::vector<int> cols_;         // the coarse blocks of the current row of A P
+    std::vector<double> scratch_;   // the current row of A P: rb x cb per block
+};
+
+}  // namespace edgefem::amg
