@@ -120,19 +120,25 @@ std::vector<index_t> below(const Mesh& m, int axis, double limit) {
 std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, const std::string& only) {
     std::vector<AccScene> out;
     const double span = quick ? 0.5 : 1.0;
-    if (only.empty() || only == "cantilever") {
-        AccScene a;
-        a.name = "cantilever";
-        a.mesh_origin = "box 12x3x3";
-        a.scene.mesh = make_box(12, 3, 3, 0.01);
-        a.scene.materials = Material{2e5, 0.35, 1000};
-        a.scene.gravity = {0, 0, -9.81};
-        a.scene.fixed = below(a.scene.mesh, 0, coord(a.scene.mesh, 0, false) + 1e-9);
-        a.duration = 0.5 * span;
-        a.samples = int(10 * span);
-        a.dt_ref = 2e-5;
-        out.push_back(std::move(a));
-    }
+    // Clamped at x = min, released from rest under gravity -z (explicit_dts
+    // empty: the standard configurations).
+    auto clamped_under_gravity = [&](const char* name, const char* origin, Mesh mesh, Material mat, double dt_ref,
+                                     std::vector<double> explicit_dts) {
+        AccScene d;
+        d.name = name;
+        d.mesh_origin = origin;
+        d.scene.mesh = std::move(mesh);
+        d.scene.materials = mat;
+        d.scene.gravity = {0, 0, -9.81};
+        d.scene.fixed = below(d.scene.mesh, 0, coord(d.scene.mesh, 0, false) + 1e-9);
+        d.duration = 0.5 * span;
+        d.samples = int(10 * span);
+        d.dt_ref = dt_ref;
+        d.explicit_dts = std::move(explicit_dts);
+        out.push_back(std::move(d));
+    };
+    if (only.empty() || only == "cantilever")
+        clamped_under_gravity("cantilever", "box 12x3x3", make_box(12, 3, 3, 0.01), Material{2e5, 0.35, 1000}, 2e-5, {});
     if (only.empty() || only == "twist") {
         AccScene b;
         b.name = "twist";
@@ -153,38 +159,29 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
         b.dt_ref = 2e-5;
         out.push_back(std::move(b));
     }
-    if (only.empty() || only == "bunny") {
-        AccScene c;
-        c.name = "bunny";
-        Mesh m = load_named_mesh(mesh_folder, "bunny-4k", &c.mesh_origin);
+    // bunny-4k standing on the lowest 5 % of its height (y).
+    auto standing_bunny = [&](const char* name, Material mat) {
+        AccScene d;
+        d.name = name;
+        Mesh m = load_named_mesh(mesh_folder, "bunny-4k", &d.mesh_origin);
         validate_mesh(m);
-        c.scene.mesh = std::move(m);
-        c.scene.materials = Material{5e4, 0.4, 1000};
+        d.scene.mesh = std::move(m);
+        d.scene.materials = mat;
+        const double y0 = coord(d.scene.mesh, 1, false), y1 = coord(d.scene.mesh, 1, true);
+        d.scene.fixed = below(d.scene.mesh, 1, y0 + 0.05 * (y1 - y0));
+        return d;
+    };
+    if (only.empty() || only == "bunny") {
+        AccScene c = standing_bunny("bunny", Material{5e4, 0.4, 1000});
         c.scene.gravity = {0, -9.81, 0};
-        const double y0 = coord(c.scene.mesh, 1, false), y1 = coord(c.scene.mesh, 1, true);
-        c.scene.fixed = below(c.scene.mesh, 1, y0 + 0.05 * (y1 - y0));
         c.duration = 0.3 * span;
         c.samples = int(6 * span);
         c.dt_ref = 5e-5;
         out.push_back(std::move(c));
     }
-    // Thin bodies clamped at x = min, released from rest under gravity -z.
-    auto clamped_under_gravity = [&](const char* name, const char* origin, Mesh mesh, Material mat) {
-        AccScene d;
-        d.name = name;
-        d.mesh_origin = origin;
-        d.scene.mesh = std::move(mesh);
-        d.scene.materials = mat;
-        d.scene.gravity = {0, 0, -9.81};
-        d.scene.fixed = below(d.scene.mesh, 0, coord(d.scene.mesh, 0, false) + 1e-9);
-        d.duration = 0.5 * span;
-        d.samples = int(10 * span);
-        d.dt_ref = 1e-4;
-        d.explicit_dts = {1e-5, 1.25e-5, 2e-5};
-        out.push_back(std::move(d));
-    };
     if (only.empty() || only == "slender")
-        clamped_under_gravity("slender", "box 48x3x3, 5 mm", make_box(48, 3, 3, 0.005), Material{1e7, 0.45, 1000});
+        clamped_under_gravity("slender", "box 48x3x3, 5 mm", make_box(48, 3, 3, 0.005), Material{1e7, 0.45, 1000}, 1e-4,
+                              {1e-5, 1.25e-5, 2e-5});
     // Driven smoothly from rest by prescribed vertices: the fraction
     // (1 - cos(pi t / T)) / 2 of their displacement up to T, then 1
     // (keyframes every T / 30).
@@ -199,14 +196,8 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
         d.dt_ref = 1e-4;
     };
     if (only.empty() || only == "press") {
-        AccScene d;
-        d.name = "press";
-        Mesh m = load_named_mesh(mesh_folder, "bunny-4k", &d.mesh_origin);
-        validate_mesh(m);
-        d.scene.mesh = std::move(m);
-        d.scene.materials = Material{5e4, 0.49, 1000};
+        AccScene d = standing_bunny("press", Material{5e4, 0.49, 1000});
         const double y0 = coord(d.scene.mesh, 1, false), y1 = coord(d.scene.mesh, 1, true);
-        d.scene.fixed = below(d.scene.mesh, 1, y0 + 0.05 * (y1 - y0));
         std::vector<index_t> top;
         for (index_t v = 0; v < d.scene.mesh.num_vertices(); ++v)
             if (d.scene.mesh.X[3 * v + 1] >= y1 - 0.1 * (y1 - y0)) top.push_back(v);
