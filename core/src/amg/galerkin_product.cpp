@@ -21,6 +21,83 @@ void block_columns(const SparseRows& A, std::size_t I, int b, std::vector<int>& 
         }
 }
 
+// What multiply_blocks reads and writes of a GalerkinProduct.
+struct Work {
+    const std::vector<int>& start;  // the result's block pattern
+    const std::vector<int>& col;
+    std::vector<int>& slot;
+    std::vector<int>& cols;
+    std::vector<double>& scratch;
+    const int* outer;  // the result's scalar rows
+    double* val;
+};
+
+// The blocks on and above the diagonal of P^T A P, added row by row of A;
+// RB x CB blocks of P (0: P's own sizes, at run time). False when a block
+// falls outside the pattern.
+template <int RB, int CB>
+bool multiply_blocks(const SparseRows& A, const BlockRowsView& P, const Work& o) {
+    const int rb = RB ? RB : P.rb, cb = CB ? CB : P.cb;
+    const std::size_t w = std::size_t(rb) * std::size_t(cb);
+    for (std::size_t I = 0; I < P.block_rows; ++I) {
+        // Row I of A P: rb x cb per coarse block, summed over A's entries.
+        o.cols.clear();
+        for (int r = 0; r < rb; ++r)
+            for (SparseRows::InnerIterator it(A, Eigen::Index(I) * rb + r); it; ++it) {
+                const std::size_t J = std::size_t(it.col() / rb);
+                const int j = int(it.col() % rb);
+                const double v = it.value();
+                for (int k = P.start[J]; k < P.start[J + 1]; ++k) {
+                    const int c = P.col[k];
+                    if (o.slot[std::size_t(c)] < 0) {
+                        o.slot[std::size_t(c)] = int(o.cols.size());
+                        o.cols.push_back(c);
+                        if (o.scratch.size() < o.cols.size() * w) o.scratch.resize(o.cols.size() * w);
+                        std::fill_n(o.scratch.begin() + std::ptrdiff_t((o.cols.size() - 1) * w), w, 0.0);
+                    }
+                    double* s = o.scratch.data() + std::size_t(o.slot[std::size_t(c)]) * w + std::size_t(r) * std::size_t(cb);
+                    const float* p = P.val + std::size_t(k) * w + std::size_t(j) * std::size_t(cb);
+                    for (int y = 0; y < cb; ++y) s[y] += v * double(p[y]);
+                }
+            }
+        // P's blocks of row I, transposed, times it, into the blocks on and
+        // above the diagonal.
+        bool covered = true;
+        for (int kp = P.start[I]; kp < P.start[I + 1] && covered; ++kp) {
+            const std::size_t a = std::size_t(P.col[kp]);
+            const float* pa = P.val + std::size_t(kp) * w;  // pa[r cb + x] = P(I rb + r, a cb + x)
+            double pt[(RB ? RB : 6) * (CB ? CB : 6)];       // P's block transposed, in double
+            const bool fits = RB || w <= sizeof pt / sizeof pt[0];
+            if (fits)
+                for (int r = 0; r < rb; ++r)
+                    for (int x = 0; x < cb; ++x) pt[x * rb + r] = double(pa[r * cb + x]);
+            const int* first = o.col.data() + o.start[a];
+            const int* last = o.col.data() + o.start[a + 1];
+            for (std::size_t t = 0; t < o.cols.size(); ++t) {
+                if (std::size_t(o.cols[t]) < a) continue;
+                const int* pos = std::lower_bound(first, last, o.cols[t]);
+                if (pos == last || *pos != o.cols[t]) {
+                    covered = false;
+                    break;
+                }
+                const std::size_t k = std::size_t(pos - first);
+                const double* s = o.scratch.data() + t * w;
+                for (int x = 0; x < cb; ++x) {
+                    double* out = o.val + o.outer[a * std::size_t(cb) + std::size_t(x)] + k * std::size_t(cb);
+                    for (int r = 0; r < rb; ++r) {
+                        const double pr = fits ? pt[x * rb + r] : double(pa[std::size_t(r) * std::size_t(cb) + std::size_t(x)]);
+                        const double* sr = s + std::size_t(r) * std::size_t(cb);
+                        for (int y = 0; y < cb; ++y) out[y] += pr * sr[y];
+                    }
+                }
+            }
+        }
+        for (const int c : o.cols) o.slot[std::size_t(c)] = -1;
+        if (!covered) return false;
+    }
+    return true;
+}
+
 }  // namespace
 
 void GalerkinProduct::find_pattern(const SparseRows& A, const BlockRowsView& P, std::size_t coarse_blocks) {
@@ -40,6 +117,11 @@ void GalerkinProduct::find_pattern(const SparseRows& A, const BlockRowsView& P, 
             row.insert(row.end(), ap.begin(), ap.end());
         }
     }
+    // Symmetric (P^T A P is, for a symmetric A): only the blocks on and
+    // above the diagonal are formed, the others mirrored from them.
+    for (std::size_t a = 0; a < coarse_blocks; ++a)
+        for (std::size_t k = 0, n = rows[a].size(); k < n; ++k)
+            if (const int c = rows[a][k]; std::size_t(c) != a) rows[std::size_t(c)].push_back(int(a));
     start_.assign(coarse_blocks + 1, 0);
     col_.clear();
     for (std::size_t a = 0; a < coarse_blocks; ++a) {
@@ -54,8 +136,7 @@ void GalerkinProduct::find_pattern(const SparseRows& A, const BlockRowsView& P, 
 }
 
 bool GalerkinProduct::multiply(const SparseRows& A, const BlockRowsView& P, SparseRows& out) {
-    const int rb = P.rb, cb = P.cb;
-    const std::size_t w = std::size_t(rb) * std::size_t(cb);
+    const int cb = P.cb;
     const std::size_t nbc = start_.size() - 1;
     // The result's scalar pattern: block row a's scalar rows each hold its
     // blocks' cb columns in block order.
@@ -74,55 +155,29 @@ bool GalerkinProduct::multiply(const SparseRows& A, const BlockRowsView& P, Spar
             outer[row + 1] = at;
         }
     std::fill(val, val + out.nonZeros(), 0.0);
-    for (std::size_t I = 0; I < P.block_rows; ++I) {
-        // Row I of A P: rb x cb per coarse block, summed over A's entries.
-        cols_.clear();
-        for (int r = 0; r < rb; ++r)
-            for (SparseRows::InnerIterator it(A, Eigen::Index(I) * rb + r); it; ++it) {
-                const std::size_t J = std::size_t(it.col() / rb);
-                const int j = int(it.col() % rb);
-                const double v = it.value();
-                for (int k = P.start[J]; k < P.start[J + 1]; ++k) {
-                    const int c = P.col[k];
-                    if (slot_[std::size_t(c)] < 0) {
-                        slot_[std::size_t(c)] = int(cols_.size());
-                        cols_.push_back(c);
-                        if (scratch_.size() < cols_.size() * w) scratch_.resize(cols_.size() * w);
-                        std::fill_n(scratch_.begin() + std::ptrdiff_t((cols_.size() - 1) * w), w, 0.0);
-                    }
-                    double* s = scratch_.data() + std::size_t(slot_[std::size_t(c)]) * w + std::size_t(r) * std::size_t(cb);
-                    const float* p = P.val + std::size_t(k) * w + std::size_t(j) * std::size_t(cb);
-                    for (int y = 0; y < cb; ++y) s[y] += v * double(p[y]);
-                }
-            }
-        // P's blocks of row I, transposed, times it, into their blocks.
-        bool covered = true;
-        for (int kp = P.start[I]; kp < P.start[I + 1] && covered; ++kp) {
-            const std::size_t a = std::size_t(P.col[kp]);
-            const float* pa = P.val + std::size_t(kp) * w;  // pa[r cb + x] = P(I rb + r, a cb + x)
-            const int* first = col_.data() + start_[a];
-            const int* last = col_.data() + start_[a + 1];
-            for (std::size_t t = 0; t < cols_.size(); ++t) {
-                const int* pos = std::lower_bound(first, last, cols_[t]);
-                if (pos == last || *pos != cols_[t]) {
-                    covered = false;
-                    break;
-                }
-                const std::size_t k = std::size_t(pos - first);
-                const double* s = scratch_.data() + t * w;
-                for (int x = 0; x < cb; ++x) {
-                    double* o = val + outer[a * std::size_t(cb) + std::size_t(x)] + k * std::size_t(cb);
-                    for (int r = 0; r < rb; ++r) {
-                        const double pr = double(pa[std::size_t(r) * std::size_t(cb) + std::size_t(x)]);
-                        const double* sr = s + std::size_t(r) * std::size_t(cb);
-                        for (int y = 0; y < cb; ++y) o[y] += pr * sr[y];
-                    }
-                }
-            }
+    const Work work{start_, col_, slot_, cols_, scratch_, outer, val};
+    bool covered;
+    if (P.rb == 3 && P.cb == 6)
+        covered = multiply_blocks<3, 6>(A, P, work);
+    else if (P.rb == 6 && P.cb == 6)
+        covered = multiply_blocks<6, 6>(A, P, work);
+    else
+        covered = multiply_blocks<0, 0>(A, P, work);
+    if (!covered) return false;
+    // The blocks below the diagonal: the transposes of those above.
+    for (std::size_t a = 0; a < nbc; ++a)
+        for (int k = start_[a]; k < start_[a + 1]; ++k) {
+            const std::size_t b = std::size_t(col_[std::size_t(k)]);
+            if (b <= a) continue;
+            const int* first = col_.data() + start_[b];
+            const int* last = col_.data() + start_[b + 1];
+            const std::size_t kb = std::size_t(std::lower_bound(first, last, int(a)) - first);
+            const std::size_t ka = std::size_t(k - start_[a]);
+            for (int x = 0; x < cb; ++x)
+                for (int y = 0; y < cb; ++y)
+                    val[outer[b * std::size_t(cb) + std::size_t(y)] + kb * std::size_t(cb) + std::size_t(x)] =
+                        val[outer[a * std::size_t(cb) + std::size_t(x)] + ka * std::size_t(cb) + std::size_t(y)];
         }
-        for (const int c : cols_) slot_[std::size_t(c)] = -1;
-        if (!covered) return false;
-    }
     return true;
 }
 

@@ -5,8 +5,12 @@
 // pattern of P^T A P (in vertex blocks) is found at the first product and
 // kept (again only when A brings an entry it does not cover); each product
 // then runs row by row of A: its row of A P summed into a small scratch,
-// then P's blocks of that row times it added into the pattern's blocks.
-// One thread, a fixed order: the same bits for any executor.
+// then P's blocks of that row times it added into the pattern's blocks on
+// and above the diagonal (block sizes fixed at compile time for the 3x6 and
+// 6x6 prolongators); the blocks below are their transposes (P^T A P is
+// symmetric for a symmetric A; for a float model's A, symmetric to its
+// round-off, this makes the coarse operators exactly so). One thread, a
+// fixed order: the same bits for any executor.
 #pragma once
 
 #include <cstddef>
