@@ -485,9 +485,10 @@ struct SmoothedAggregation::Impl {
     std::shared_ptr<const Executor> ex;  // null or one thread: serial
 
     bool threaded() const { return ex && ex->threads() > 1; }
-    // Level L's prolongator as it is held (P, or R's transpose), expanded.
-    static SparseRows prolongator(const Level& L) {
-        return L.P.rows > 0 ? L.P.expand() : SparseRows(L.R.expand().transpose());
+    // Level L's prolongator in block rows: P where it holds P, else R's
+    // transpose made in `scratch`.
+    static const BlockRows& prolongator(const Level& L, BlockRows& scratch) {
+        return L.P.rows > 0 ? L.P : (scratch = L.R.transposed());
     }
     // Holds level L's prolongator the way the executor uses it.
     void hold(Level& L) const {
@@ -701,9 +702,8 @@ void SmoothedAggregation::refresh(const SparseRows& A) {
     for (std::size_t l = 0; l < m.level.size(); ++l) {
         Impl::Level& L = m.level[l];
         if (l > 0) {
-            const Impl::Level& up = m.level[l - 1];
-            BlockRows held;  // P, where the level above holds R = P^T
-            const BlockRows& P = up.P.rows > 0 ? up.P : (held = up.R.transposed());
+            BlockRows scratch;
+            const BlockRows& P = Impl::prolongator(m.level[l - 1], scratch);
             const amg::BlockRowsView view{P.start.size() - 1, P.rb, P.cb, P.start.data(), P.col.data(), P.val.data()};
             L.galerkin(*Al, view, std::size_t(P.cols / P.cb), Anext);
             Acur.swap(Anext);
@@ -746,7 +746,10 @@ index_t SmoothedAggregation::dofs(int l) const {
     return index_t(L.Minv.size() / std::size_t(L.bs));
 }
 const SparseRows& SmoothedAggregation::tentative(int l) const { return impl_->level[std::size_t(l)].P_tent; }
-SparseRows SmoothedAggregation::prolongator(int l) const { return Impl::prolongator(impl_->level[std::size_t(l)]); }
+SparseRows SmoothedAggregation::prolongator(int l) const {
+    BlockRows scratch;
+    return Impl::prolongator(impl_->level[std::size_t(l)], scratch).expand();
+}
 const Eigen::MatrixXd& SmoothedAggregation::near_nullspace(int l) const { return impl_->level[std::size_t(l)].B; }
 SparseRows SmoothedAggregation::matrix(int l) const { return impl_->level[std::size_t(l)].A.expand(); }
 

@@ -29,11 +29,34 @@ Eigen::MatrixXd dense(const SparseRows& A) {
     return D;
 }
 
+// L's strict lower triangle rounded to float and packed by rows, and D,
+// from a factorisation's entries (l(i, j), j < i; d(i)); false on a zero or
+// non-finite value. `negative`: D has a negative entry.
+template <class LowerAt, class DAt>
+bool pack(std::size_t n, LowerAt&& l, DAt&& d, std::vector<float>& lower, std::vector<double>& diag, bool& negative) {
+    diag.resize(n);
+    negative = false;
+    for (std::size_t i = 0; i < n; ++i) {
+        diag[i] = d(Eigen::Index(i));
+        if (!std::isfinite(diag[i]) || diag[i] == 0) return false;
+        negative = negative || diag[i] < 0;
+    }
+    lower.resize(n * (n - (n > 0)) / 2);
+    for (std::size_t i = 1; i < n; ++i)
+        for (std::size_t j = 0; j < i; ++j) {
+            const double v = l(Eigen::Index(i), Eigen::Index(j));
+            if (!std::isfinite(v)) return false;
+            lower[i * (i - 1) / 2 + j] = float(v);
+        }
+    return true;
+}
+
 }  // namespace
 
 bool CoarseLdlt::factor(const SparseRows& A) {
     n_ = std::size_t(A.rows());
     const auto n = Eigen::Index(n_);
+    y_.resize(n_);
     // A definite operator (the usual case) by Cholesky, blocked (matrix
     // products: 5-10x Eigen's LDLT, which is rank-1 updates), in place;
     // L D L^T with L's unit diagonal and D the squares of the Cholesky
@@ -41,26 +64,13 @@ bool CoarseLdlt::factor(const SparseRows& A) {
     // meets a non-positive pivot) by the pivoted LDL^T.
     {
         Eigen::MatrixXd C = dense(A);
-        Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(C);
+        const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(C);
         if (llt.info() == Eigen::Success) {
             perm_.resize(n_);
-            d_.resize(n_);
-            negative_ = false;
-            for (std::size_t i = 0; i < n_; ++i) {
-                perm_[i] = int(i);
-                const double c = C(Eigen::Index(i), Eigen::Index(i));
-                d_[i] = c * c;
-                if (!std::isfinite(d_[i]) || d_[i] == 0) return false;
-            }
-            lower_.resize(n_ * (n_ - (n_ > 0)) / 2);
-            for (std::size_t i = 1; i < n_; ++i)
-                for (std::size_t j = 0; j < i; ++j) {
-                    const double l = C(Eigen::Index(i), Eigen::Index(j)) / C(Eigen::Index(j), Eigen::Index(j));
-                    if (!std::isfinite(l)) return false;
-                    lower_[i * (i - 1) / 2 + j] = float(l);
-                }
-            y_.resize(n_);
-            return true;
+            for (std::size_t i = 0; i < n_; ++i) perm_[i] = int(i);
+            return pack(
+                n_, [&](Eigen::Index i, Eigen::Index j) { return C(i, j) / C(j, j); },
+                [&](Eigen::Index i) { return C(i, i) * C(i, i); }, lower_, d_, negative_);
         }
     }
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(dense(A));  // C was overwritten
@@ -72,22 +82,9 @@ bool CoarseLdlt::factor(const SparseRows& A) {
     perm_.resize(n_);
     for (std::size_t k = 0; k < n_; ++k) perm_[k] = int(moved[Eigen::Index(k)]);
     const Eigen::MatrixXd& L = ldlt.matrixLDLT();  // L strictly below the diagonal (unit diagonal implied)
-    d_.resize(n_);
-    negative_ = false;
-    for (std::size_t i = 0; i < n_; ++i) {
-        d_[i] = ldlt.vectorD()[Eigen::Index(i)];
-        if (!std::isfinite(d_[i]) || d_[i] == 0) return false;
-        negative_ = negative_ || d_[i] < 0;
-    }
-    lower_.resize(n_ * (n_ - (n_ > 0)) / 2);
-    for (std::size_t i = 1; i < n_; ++i)
-        for (std::size_t j = 0; j < i; ++j) {
-            const double l = L(Eigen::Index(i), Eigen::Index(j));
-            if (!std::isfinite(l)) return false;
-            lower_[i * (i - 1) / 2 + j] = float(l);
-        }
-    y_.resize(n_);
-    return true;
+    return pack(
+        n_, [&](Eigen::Index i, Eigen::Index j) { return L(i, j); }, [&](Eigen::Index i) { return ldlt.vectorD()[i]; },
+        lower_, d_, negative_);
 }
 
 void CoarseLdlt::solve(const double* b, double* x) const {

@@ -1,6 +1,7 @@
 #include "amg/galerkin_product.hpp"
 
 #include <algorithm>
+#include <string>
 
 #include "edgefem/core/error.hpp"
 
@@ -33,12 +34,11 @@ struct Work {
 };
 
 // The blocks on and above the diagonal of P^T A P, added row by row of A;
-// RB x CB blocks of P (0: P's own sizes, at run time). False when a block
-// falls outside the pattern.
+// RB x CB blocks of P. False when a block falls outside the pattern.
 template <int RB, int CB>
 bool multiply_blocks(const SparseRows& A, const BlockRowsView& P, const Work& o) {
-    const int rb = RB ? RB : P.rb, cb = CB ? CB : P.cb;
-    const std::size_t w = std::size_t(rb) * std::size_t(cb);
+    constexpr int rb = RB, cb = CB;
+    constexpr std::size_t w = std::size_t(rb) * std::size_t(cb);
     for (std::size_t I = 0; I < P.block_rows; ++I) {
         // Row I of A P: rb x cb per coarse block, summed over A's entries.
         o.cols.clear();
@@ -66,11 +66,9 @@ bool multiply_blocks(const SparseRows& A, const BlockRowsView& P, const Work& o)
         for (int kp = P.start[I]; kp < P.start[I + 1] && covered; ++kp) {
             const std::size_t a = std::size_t(P.col[kp]);
             const float* pa = P.val + std::size_t(kp) * w;  // pa[r cb + x] = P(I rb + r, a cb + x)
-            double pt[(RB ? RB : 6) * (CB ? CB : 6)];       // P's block transposed, in double
-            const bool fits = RB || w <= sizeof pt / sizeof pt[0];
-            if (fits)
-                for (int r = 0; r < rb; ++r)
-                    for (int x = 0; x < cb; ++x) pt[x * rb + r] = double(pa[r * cb + x]);
+            double pt[w];                                   // P's block transposed, in double
+            for (int r = 0; r < rb; ++r)
+                for (int x = 0; x < cb; ++x) pt[x * rb + r] = double(pa[r * cb + x]);
             const int* first = o.col.data() + o.start[a];
             const int* last = o.col.data() + o.start[a + 1];
             for (std::size_t t = 0; t < o.cols.size(); ++t) {
@@ -85,7 +83,7 @@ bool multiply_blocks(const SparseRows& A, const BlockRowsView& P, const Work& o)
                 for (int x = 0; x < cb; ++x) {
                     double* out = o.val + o.outer[a * std::size_t(cb) + std::size_t(x)] + k * std::size_t(cb);
                     for (int r = 0; r < rb; ++r) {
-                        const double pr = fits ? pt[x * rb + r] : double(pa[std::size_t(r) * std::size_t(cb) + std::size_t(x)]);
+                        const double pr = pt[x * rb + r];
                         const double* sr = s + std::size_t(r) * std::size_t(cb);
                         for (int y = 0; y < cb; ++y) out[y] += pr * sr[y];
                     }
@@ -162,7 +160,8 @@ bool GalerkinProduct::multiply(const SparseRows& A, const BlockRowsView& P, Spar
     else if (P.rb == 6 && P.cb == 6)
         covered = multiply_blocks<6, 6>(A, P, work);
     else
-        covered = multiply_blocks<0, 0>(A, P, work);
+        throw InvalidArgument("GalerkinProduct: prolongator blocks of " + std::to_string(P.rb) + " x " +
+                              std::to_string(P.cb) + ", expected 3 x 6 or 6 x 6");
     if (!covered) return false;
     // The blocks below the diagonal: the transposes of those above.
     for (std::size_t a = 0; a < nbc; ++a)

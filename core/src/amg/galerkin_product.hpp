@@ -6,7 +6,7 @@
 // kept (again only when A brings an entry it does not cover); each product
 // then runs row by row of A: its row of A P summed into a small scratch,
 // then P's blocks of that row times it added into the pattern's blocks on
-// and above the diagonal (block sizes fixed at compile time for the 3x6 and
+// and above the diagonal (block sizes fixed at compile time: the 3x6 and
 // 6x6 prolongators); the blocks below are their transposes (P^T A P is
 // symmetric for a symmetric A; for a float model's A, symmetric to its
 // round-off, this makes the coarse operators exactly so). One thread, a
@@ -32,9 +32,11 @@ struct BlockRowsView {
 
 class GalerkinProduct {
 public:
-    // P^T A P for A square (its rows and columns in blocks of P.rb, A's
-    // order P.block_rows * P.rb) and P with `coarse_blocks` block columns;
-    // every block of the result's pattern is stored whole (zeros included).
+    // P^T A P for A square and symmetric (its rows and columns in blocks of
+    // P.rb, A's order P.block_rows * P.rb; the blocks below the result's
+    // diagonal are taken as the transposes of those above) and P of 3 x 6 or
+    // 6 x 6 blocks with `coarse_blocks` block columns; every block of the
+    // result's pattern is stored whole (zeros included).
     // `out` is overwritten (its storage reused where it is large enough).
     void operator()(const SparseRows& A, const BlockRowsView& P, std::size_t coarse_blocks, SparseRows& out);
     // Bytes it keeps between products (the pattern and the scratch).
