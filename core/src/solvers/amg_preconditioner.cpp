@@ -8,7 +8,11 @@
 // of residual reduction stay within 1.5x (+ 2 iterations) of those after
 // the last refresh, the coefficients (the step size) are unchanged and the
 // coarsest level was definite (an indefinite
-// one is reported as negative curvature: Preconditioner::indefinite). The
+// one is reported as negative curvature: Preconditioner::indefinite). A
+// refresh that is stale in the very next solve (K changes that fast: soft
+// material, long steps) makes the next kEagerSetups set-ups refresh
+// without waiting for a stale solve, then one is skipped again to see
+// whether K has settled (the probe). The
 // finest level's products are the LinearSystem's
 // matrix-free ones (the per-edge K on the back-end's executor). A
 // whole-vector preconditioner: one V-cycle per CG iteration. On the host,
@@ -42,29 +46,30 @@ public:
         ++age_;
         // An indefinite coarsest level is refreshed at the next set-up under
         // any interval: that set-up is the definite K the step falls back to.
-        const bool due = amg_.coarsest_indefinite() || (interval > 0 ? age_ >= interval : stale_ || c != c_);
+        const bool due =
+            amg_.coarsest_indefinite() || (interval > 0 ? age_ >= interval : stale_ || eager_ > 0 || c != c_);
+        if (eager_ > 0) --eager_;
         if (built_ && !due) return;
-        matrix_.assemble(A);
-        if (!built_) {
-            amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host, s_.scene.solver.amg);
-            amg_.release_build_data();
-            built_at_.record(s_, A);
-            refreshed_at_.valid = false;
-        } else {
-            amg_.refresh(matrix_.projected());
-            refreshed_at_.record(s_, A);
-        }
-        matrix_.release();  // assembled again at the next refresh
-        ++refreshes_;
-        built_ = true;
-        c_ = c;
-        age_ = 0;
-        stale_ = false;
-        fresh_rate_ = -1;
+        refresh(A, c);
     }
 
     bool indefinite() const override { return amg_.coarsest_indefinite(); }
     int refreshes() const override { return refreshes_; }
+
+    // A lagged AMG's solve that has gone far past the iterations after its
+    // last refresh (3x + 10) refreshes on the A being solved and goes on
+    // from its iterate: a hierarchy made stale by a large change of K can
+    // need hundreds of times the iterations (a soft beam folding at 33 ms
+    // steps: 728 and 4,022 where a fresh one takes 11).
+    int switch_after() const override {
+        return s_.scene.solver.amg_refresh_interval == 0 && fresh_its_ > 0 ? 3 * fresh_its_ + 10 : 0;
+    }
+    void switch_now(LinearSystem<S>& A, int /*iterations*/, double /*residual*/) override {
+        const bool young = age_ == 1;  // stale one set-up after a refresh: K changes that fast
+        refresh(A, {A.c_m(), A.c_k(), A.c_b()});
+        skip_ = true;  // the rest of this solve starts from its iterate: no fresh rate
+        if (young) eager_ = kEagerSetups;
+    }
 
     // Per decade of the residual reduction reached, so that Newton's
     // solves, whose tolerances change from one iteration to the next (the
@@ -73,10 +78,24 @@ public:
     // Newton iteration). A semi-implicit step's solves all ask for the same
     // tolerance: for them it is the iteration count as before.
     void solved(int iterations, double residual) override {
+        if (skip_) {
+            skip_ = false;
+            return;
+        }
         const double decades = std::max(1.0, -std::log10(std::max(residual, 1e-300)));
-        if (fresh_rate_ < 0) fresh_rate_ = iterations / decades;
-        else if (iterations > 1.5 * fresh_rate_ * decades + 2) stale_ = true;
+        // The solve right after a set-up's refresh (or, with none measured
+        // yet, the first whole solve since).
+        if (measure_ && (age_ == 0 || fresh_rate_ < 0)) {
+            measure_ = false;
+            fresh_rate_ = iterations / decades;
+            fresh_its_ = iterations;
+        } else if (fresh_rate_ >= 0 && iterations > 1.5 * fresh_rate_ * decades + 2) {
+            stale_ = true;
+            if (age_ == 1) eager_ = kEagerSetups;  // the refresh lived one set-up
+        }
     }
+
+    void invalidate() override { stale_ = true; }
 
     // The hierarchy and the last refresh are rebuilt from the points they
     // were made at (the matrices would take ~100x the space).
@@ -86,6 +105,10 @@ public:
         w.value(age_);
         w.value(stale_);
         w.value(fresh_rate_);
+        w.value(eager_);
+        w.value(fresh_its_);
+        w.value(measure_);
+        w.value(skip_);
         built_at_.save(w);
         refreshed_at_.save(w);
     }
@@ -95,6 +118,11 @@ public:
         age_ = r.value<int>("AMG age");
         stale_ = r.value<bool>("AMG stale");
         fresh_rate_ = r.value<double>("AMG iterations per decade");
+        eager_ = r.value<int>("AMG eager set-ups");
+        if (eager_ < 0 || eager_ > kEagerSetups) r.fail("AMG", "eager set-ups out of range");
+        fresh_its_ = r.value<int>("AMG iterations after the refresh");
+        measure_ = r.value<bool>("AMG measure flag");
+        skip_ = r.value<bool>("AMG skip flag");
         built_at_.load(r, s_.n());
         refreshed_at_.load(r, s_.n());
         if (built_ != built_at_.valid) r.fail("AMG", "built without its point");
@@ -130,6 +158,28 @@ public:
     std::size_t bytes() const override { return amg_.bytes() + matrix_.bytes(); }
 
 private:
+    // Builds the hierarchy (the first time) or refreshes its operators on A.
+    void refresh(LinearSystem<S>& A, const std::array<double, 3>& c) {
+        matrix_.assemble(A);
+        if (!built_) {
+            amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host, s_.scene.solver.amg);
+            amg_.release_build_data();
+            built_at_.record(s_, A);
+            refreshed_at_.valid = false;
+        } else {
+            amg_.refresh(matrix_.projected());
+            refreshed_at_.record(s_, A);
+        }
+        matrix_.release();  // assembled again at the next refresh
+        ++refreshes_;
+        built_ = true;
+        c_ = c;
+        age_ = 0;
+        stale_ = false;
+        measure_ = true;
+    }
+
+    static constexpr int kEagerSetups = 4;  // refreshes in a row after a one-set-up-old refresh was stale
     const SimState<S>& s_;
     std::shared_ptr<const Executor> ex_;  // the back-end's threads (null: serial)
     SystemMatrix<S> matrix_;
@@ -139,7 +189,13 @@ private:
     std::array<double, 3> c_{};  // c_m, c_k, c_b at the last refresh
     int age_ = 0;                // set-ups since the last refresh
     bool stale_ = false;         // the iterations grew: refresh at the next K
-    double fresh_rate_ = -1;     // CG's iterations per decade right after the last refresh
+    // CG's iterations (per decade, and of the solve) right after the last
+    // refresh that was followed by a whole solve (-1 and 0: none yet).
+    double fresh_rate_ = -1;
+    int fresh_its_ = 0;
+    bool measure_ = false;       // the next solve after a set-up's refresh measures them
+    int eager_ = 0;              // set-ups still to refresh without waiting for a stale solve
+    bool skip_ = false;          // the solve under way refreshed part way: it measures nothing
     int refreshes_ = 0;          // builds and refreshes so far
     TangentPoint<S> built_at_, refreshed_at_;  // where the hierarchy was built and last refreshed (checkpoints)
 };

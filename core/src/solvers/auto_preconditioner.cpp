@@ -1,59 +1,184 @@
 // The automatic choice (SolverSettings::preconditioner Auto, the default):
-// block-Jacobi until one of its solves needs more than
-// SolverSettings::auto_amg_iterations CG iterations; that solve goes on from
-// its iterate under AMG (set up on the same K), and AMG stays to the end of
-// the run. So a step too large for block-Jacobi's iteration limit does not
-// fail on it. Where block-Jacobi needs few iterations (small
-// steps, soft or small meshes) an iteration of it is ~16-19x cheaper than an
-// AMG one and it wins; past the threshold AMG's 7-17 iterations win
-// (docs/solvers.md, "Which preconditioner by default"). The switch depends on
-// iteration counts only, which are the same for any thread count: so is the
-// run. Never AMG with a fixed CG budget (cg_fixed_iterations: a haptic loop's
-// iteration costs must stay block-Jacobi's) or off the host (AMG runs there).
+// block-Jacobi until one of its solves needs more than a threshold of CG
+// iterations (at first SolverSettings::auto_amg_iterations); that solve goes
+// on from its iterate under AMG (set up on the same K). Where block-Jacobi
+// needs few iterations (small steps, soft or small meshes) an iteration of it
+// is ~9-11x cheaper than an AMG one and it wins; past the threshold AMG's
+// 7-17 iterations win (docs/solvers.md, "Which preconditioner by default").
+// So a step too large for block-Jacobi's iteration limit does not fail on it.
+//
+// AMG then stays while it costs less than block-Jacobi. Costs are counted,
+// not timed, in block-Jacobi CG iterations per decade of residual
+// reduction: an AMG iteration kAmgIteration, a refresh of its operators
+// kRefresh (measured on the shared meshes, docs/solvers.md). Where K changes
+// so much from step to step that the AMG refreshes at nearly every step
+// (soft material, long steps), or where its iterations grow (a body folded
+// far from its rest shape), a solve under AMG can cost more than one under
+// block-Jacobi. Block-Jacobi's cost is known from its last whole solve; of
+// the solve it gave up, only that it exceeded the threshold. When the AMG's
+// cost over its last kWindow solves exceeds that, the next set-up goes back
+// to block-Jacobi, whose threshold becomes the AMG's cost per solve (with a
+// margin): a block-Jacobi solve that stays under it was the cheaper one, one
+// that goes past it changes to AMG again (refreshed first if block-Jacobi
+// served more than one set-up), which then has the higher bound to beat.
+// Counts and residuals are the same for any thread count, so is every switch
+// and the run. Never AMG with a fixed CG budget (cg_fixed_iterations: a
+// haptic loop's iteration costs must stay block-Jacobi's) or off the host
+// (AMG runs there).
+#include <algorithm>
+#include <array>
+#include <cmath>
+
 #include "solvers/preconditioner.hpp"
 
 namespace edgefem::sim {
 
 namespace {
 
+constexpr double kAmgIteration = 10;  // block-Jacobi iterations per AMG iteration (measured 8.6-10.9)
+constexpr double kRefresh = 350;      // block-Jacobi iterations per AMG refresh (measured 230-430)
+constexpr int kWindow = 4;            // AMG solves its cost is judged over
+constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
+
+// Decades of residual reduction a solve reached (at least 1).
+double decades(double residual) { return std::max(1.0, -std::log10(std::max(residual, 1e-300))); }
+
 template <class S>
 class AutoPreconditioner final : public Preconditioner<S> {
 public:
     explicit AutoPreconditioner(const SimState<S>& state)
-        : s_(state), active_(make_block_jacobi(state)),
+        : s_(state), bj_(make_block_jacobi(state)), active_(bj_.get()),
           allowed_(state.scene.solver.cg_fixed_iterations == 0 &&
-                   state.backend->memory().space() == MemorySpace::Host) {}
+                   state.backend->memory().space() == MemorySpace::Host),
+          threshold_(state.scene.solver.auto_amg_iterations) {}
 
-    void setup(LinearSystem<S>& A) override { active_->setup(A); }
-    void solved(int iterations, double residual) override { active_->solved(iterations, residual); }
-    int switch_after() const override { return amg_ || !allowed_ ? 0 : s_.scene.solver.auto_amg_iterations; }
-    void switch_now(LinearSystem<S>& A) override {
-        active_ = make_amg(s_);
-        amg_ = true;
+    void setup(LinearSystem<S>& A) override {
+        if (back_) {  // decided by the last solve; here, so that block-Jacobi is set up before it is used
+            back_ = false;
+            active_ = bj_.get();
+            bj_setups_ = 0;
+        }
+        if (!on_amg()) ++bj_setups_;
         active_->setup(A);
     }
+
+    int switch_after() const override { return on_amg() ? amg_->switch_after() : allowed_ ? threshold_ : 0; }
+
+    void switch_now(LinearSystem<S>& A, int iterations, double residual) override {
+        if (on_amg()) return amg_->switch_now(A, iterations, residual);  // its refresh part way
+        if (!amg_) amg_ = make_amg(s_);
+        else if (bj_setups_ > 1) amg_->invalidate();  // its operators are those of an older K
+        active_ = amg_.get();
+        active_->setup(A);
+        seen_ = amg_->refreshes();
+        count_ = 0;
+        just_switched_ = true;
+    }
+
+    void solved(int iterations, double residual) override {
+        const double d = decades(residual);
+        if (!on_amg()) {
+            bj_->solved(iterations, residual);
+            bj_rate_ = iterations / d;
+            return;
+        }
+        const int refreshed = amg_->refreshes() - seen_;
+        seen_ = amg_->refreshes();
+        if (just_switched_) {
+            // Block-Jacobi would have needed more than its threshold: a lower
+            // bound on its cost. Of this solve's AMG part, its set-up is
+            // paid, and the AMG is not told it: it started from block-Jacobi's
+            // iterate, so its few iterations are no rate for the lagged
+            // AMG's staleness test to compare later solves with.
+            just_switched_ = false;
+            bj_rate_ = threshold_ / d;
+            return;
+        }
+        amg_->solved(iterations, residual);
+        window_[std::size_t(count_ % kWindow)] = {iterations * kAmgIteration + refreshed * kRefresh, d};
+        ++count_;
+        // Over the last kWindow solves; before there are that many, as soon
+        // as the ones so far cost more than block-Jacobi's rate would over
+        // the whole window (the rest counted at this solve's decades, free).
+        const int n = std::min(count_, kWindow);
+        double cost = 0, dec = (kWindow - n) * d;
+        for (int i = 0; i < n; ++i) {
+            cost += window_[std::size_t(i)][0];
+            dec += window_[std::size_t(i)][1];
+        }
+        if (cost <= bj_rate_ * dec) return;
+        back_ = true;
+        const double per_solve = kMargin * cost / n;
+        const int cap = s_.scene.solver.cg_max_iterations * 4 / 5;
+        threshold_ = std::max(s_.scene.solver.auto_amg_iterations, int(std::min<double>(cap, std::ceil(per_solve))));
+    }
+
     void save(CheckpointWriter& w) const override {
-        w.value(amg_);
-        active_->save(w);
+        w.value(on_amg());
+        w.value(bool(amg_));
+        w.value(back_);
+        w.value(just_switched_);
+        w.value(threshold_);
+        w.value(bj_rate_);
+        w.value(seen_);
+        w.value(count_);
+        w.value(bj_setups_);
+        for (const auto& [c, e] : window_) {
+            w.value(c);
+            w.value(e);
+        }
+        bj_->save(w);
+        if (amg_) amg_->save(w);
     }
     void load(CheckpointReader& r, LinearSystem<S>& A) override {
-        const bool amg = r.value<bool>("auto preconditioner: AMG active");
-        if (amg && !allowed_) r.fail("auto preconditioner", "AMG active where it cannot run");
-        if (amg != amg_) active_ = amg ? make_amg(s_) : make_block_jacobi(s_);
-        amg_ = amg;
-        active_->load(r, A);
+        const bool on_amg = r.value<bool>("auto preconditioner: AMG active");
+        const bool has_amg = r.value<bool>("auto preconditioner: AMG made");
+        if ((on_amg || has_amg) && !allowed_) r.fail("auto preconditioner", "AMG where it cannot run");
+        if (on_amg && !has_amg) r.fail("auto preconditioner", "AMG active but not made");
+        back_ = r.value<bool>("auto preconditioner: going back");
+        just_switched_ = r.value<bool>("auto preconditioner: just switched");
+        threshold_ = r.value<int>("auto preconditioner: threshold");
+        if (threshold_ < 1) r.fail("auto preconditioner", "threshold below 1");
+        bj_rate_ = r.value<double>("auto preconditioner: block-Jacobi rate");
+        seen_ = r.value<int>("auto preconditioner: refreshes seen");
+        count_ = r.value<int>("auto preconditioner: AMG solves");
+        if (count_ < 0) r.fail("auto preconditioner", "negative AMG solve count");
+        bj_setups_ = r.value<int>("auto preconditioner: block-Jacobi set-ups");
+        for (auto& [c, e] : window_) {
+            c = r.value<double>("auto preconditioner: AMG cost");
+            e = r.value<double>("auto preconditioner: AMG decades");
+        }
+        bj_->load(r, A);
+        if (has_amg) {
+            if (!amg_) amg_ = make_amg(s_);
+            amg_->load(r, A);
+        } else {
+            amg_.reset();
+        }
+        active_ = on_amg ? amg_.get() : bj_.get();
     }
-    std::size_t bytes() const override { return active_->bytes(); }
+
+    std::size_t bytes() const override { return bj_->bytes() + (amg_ ? amg_->bytes() : 0); }
     bool indefinite() const override { return active_->indefinite(); }
-    int refreshes() const override { return active_->refreshes(); }
+    int refreshes() const override { return amg_ ? amg_->refreshes() : 0; }
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override { active_->apply(lo, hi, r, z); }
     bool whole_vector() const override { return active_->whole_vector(); }
 
 private:
+    bool on_amg() const { return active_ == amg_.get(); }
+
     const SimState<S>& s_;
-    std::unique_ptr<Preconditioner<S>> active_;
+    std::unique_ptr<Preconditioner<S>> bj_, amg_;  // the AMG made at the first switch, kept (its hierarchy) after it
+    Preconditioner<S>* active_;
     const bool allowed_;
-    bool amg_ = false;  // AMG has taken over
+    int threshold_;              // block-Jacobi iterations of one solve after which AMG takes over
+    double bj_rate_ = 0;         // block-Jacobi's iterations per decade: its last whole solve, or a lower bound
+    bool back_ = false;          // the next set-up goes back to block-Jacobi
+    bool just_switched_ = false; // the solve under way changed to AMG
+    int seen_ = 0;               // the AMG's refreshes counted so far
+    int count_ = 0;              // AMG solves since it took over (but the first)
+    int bj_setups_ = 0;          // set-ups block-Jacobi served since it took over
+    std::array<std::array<double, 2>, kWindow> window_{};  // the last ones' cost and decades
 };
 
 }  // namespace

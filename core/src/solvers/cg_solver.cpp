@@ -31,18 +31,18 @@ public:
         const int after = fixed_iterations == 0 ? precond_->switch_after() : 0;
         const bool may_switch = after > 0 && after < max_it;
         CgResult res = run(A, b, x, tolerance, may_switch ? after : max_it, fixed_iterations);
-        int last = res.iterations;  // under the preconditioner active at the end
         if (may_switch && !res.converged && !res.negative_curvature) {
             // Warm-started from the iterate reached: the residual is relative to
             // the same right side, so the tolerance means what it meant.
-            precond_->switch_now(A);
+            precond_->switch_now(A, res.iterations, res.residual);
             const int before = res.iterations;
             res = run(A, b, x, tolerance, max_it - before, 0);
-            last = res.iterations;
             res.iterations += before;
         }
         if (s != 1) s_.kernels.rescale(b.data(), x.data(), s_.n(), s, false);
-        precond_->solved(last, res.residual);
+        // A solve cut short by negative curvature (the step falls back to
+        // the definite K) says nothing about the preconditioner's rate.
+        if (!res.negative_curvature) precond_->solved(res.iterations, res.residual);
         if (precond_->indefinite()) {  // see Preconditioner::indefinite
             res.negative_curvature = true;
             res.converged = false;

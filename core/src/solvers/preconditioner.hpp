@@ -15,8 +15,9 @@ template <class S>
 class Preconditioner : public CgPreconditioner {
 public:
     virtual void setup(LinearSystem<S>& A) = 0;
-    // The solve it just preconditioned: its iterations and the relative
-    // residual reached (a lagged set-up decides from them when to refresh).
+    // The solve it just preconditioned: its iterations (all of them, a
+    // change part way included) and the relative residual reached (a lagged
+    // set-up decides from them when to refresh).
     virtual void solved(int /*iterations*/, double /*residual*/) {}
     // The set-up that may outlive a step, for a checkpoint; load() rebuilds
     // it (A: the system it preconditions, its coefficients changed).
@@ -33,12 +34,16 @@ public:
     // Set-ups that recomputed its operators so far (StepStats::
     // preconditioner_refreshes).
     virtual int refreshes() const { return 0; }
+    // Makes its next set-up recompute its operators (a lagged one: as if
+    // its last solve had found them stale).
+    virtual void invalidate() {}
     // A preconditioner that gives way to a stronger one part way through a
     // solve ("auto"): the CG iterations after which a solve that has not
     // converged changes preconditioner (0: never), and the change itself,
-    // set up on the A being solved. The solve goes on from its iterate.
+    // set up on the A being solved, told the iterations run and the
+    // relative residual they reached. The solve goes on from its iterate.
     virtual int switch_after() const { return 0; }
-    virtual void switch_now(LinearSystem<S>& /*A*/) {}
+    virtual void switch_now(LinearSystem<S>& /*A*/, int /*iterations*/, double /*residual*/) {}
 };
 
 // The scene's SolverSettings::preconditioner.
