@@ -12,12 +12,15 @@
 //          aggregation (fine level assembled here) and with hypre's
 //          BoomerAMG (systems AMG, 3 functions, nodal coarsening) on the same
 //          matrix; memory of each preconditioner against the per-edge K's.
+//  run     runs of --rounds steps of block-Jacobi, the lagged AMG and `auto`
+//          (the default), a step of each in turn: mean ms per step.
 // Medians over rounds; serial (one thread). Usage:
-//   edgefem_bench_solvers [--meshes beam,bunny-4k] [--dts 1,4,10] [--rounds 9] [--parts direct,step,matrix]
+//   edgefem_bench_solvers [--meshes beam,bunny-4k] [--dts 1,4,10] [--rounds 9] [--parts direct,step,matrix,run]
 //                         [--amg-smoother chebyshev|l1] [--amg-smoothing N] [--amg-coarse DOFS]
 //                         [--amg-levels N] [--amg-ratio R] [--amg-weight W] [--amg-strength S] [--no-hypre] [--quick]
 //                         [--threads N]  (the step part on the pool back-end's N threads; default serial)
 //                         [--amg-only]   (the matrix part without block-Jacobi: the largest meshes)
+//                         [--trace]      (the run part: auto's iterations and refreshes per step, on stderr)
 // (--amg-*: AmgSettings' fields, for the step and matrix parts, to study the
 // hierarchy; unset ones keep SolverSettings' defaults)
 #include <HYPRE.h>
@@ -77,6 +80,7 @@ AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
 bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
 int g_threads = 1;                          // --threads N: the step part on the pool back-end's N threads
 std::vector<double> g_youngs;  // --youngs: Young's moduli to step each mesh at (empty: the scene's own)
+bool g_trace = false;                       // --trace: the run part prints auto's iterations and refreshes per step
 bool g_amg_only = false;                    // --amg-only: the matrix part without block-Jacobi (large meshes)
 
 std::string describe(const AmgSettings& a) {
@@ -294,6 +298,60 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
             }
             std::fflush(stdout);
         }
+}
+
+// Runs of `steps` semi-implicit steps (after one) of block-Jacobi, the lagged
+// AMG and `auto`, a step of each in turn: the mean time per step (a lagged
+// preconditioner's refreshes are periodic costs a median would hide), the
+// CG iterations and AMG refreshes per step.
+void bench_runs(const std::vector<std::string>& meshes, const std::vector<double>& dts, int steps) {
+    const std::shared_ptr<const Executor> ex = g_threads > 1 ? make_executor(ExecutorKind::Pool, g_threads) : nullptr;
+    std::printf("\n## run: semi-implicit, CG to 1e-6, %s; means over %d steps after the first, a step of each in turn\n\n",
+                ex ? ("pool x" + std::to_string(g_threads)).c_str() : "serial", steps);
+    std::printf("| mesh | Y Pa | dt ms | BJ its | AMG its | auto its | AMG refreshes | auto refreshes | BJ ms/step | "
+                "AMG ms/step | auto ms/step | AMG / BJ | auto / BJ | auto / best |\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    const std::vector<double> own{0.0};
+    const PreconditionerKind kinds[3] = {PreconditionerKind::BlockJacobi, PreconditionerKind::Amg, PreconditionerKind::Auto};
+    for (const std::string& m : meshes)
+        for (double young : g_youngs.empty() ? own : g_youngs)
+            for (double dt : dts) {
+                Scene s = named_scene(m);
+                if (young > 0) {
+                    s.materials.fallback.young = young;
+                    for (auto& [region, mat] : s.materials.by_region) mat.young = young;
+                }
+                try {
+                    std::vector<std::unique_ptr<Simulator<double>>> sim;
+                    for (PreconditionerKind k : kinds) {
+                        Scene sk = s;
+                        for_solve(sk, dt, k);
+                        sim.push_back(std::make_unique<Simulator<double>>(sk, ex, cpu_operator_factory<double>()));
+                        sim.back()->step();
+                    }
+                    double ms[3] = {0, 0, 0}, its[3] = {0, 0, 0}, refreshes[3] = {0, 0, 0};
+                    for (int r = 0; r < steps; ++r)
+                        for (int k = 0; k < 3; ++k) {
+                            const auto t0 = Clock::now();
+                            const StepStats& st = sim[std::size_t(k)]->step();
+                            ms[k] += ms_since(t0) / steps;
+                            its[k] += double(st.solver_iterations) / steps;
+                            refreshes[k] += st.preconditioner_refreshes;
+                            if (g_trace && k == 2)
+                                std::fprintf(stderr, "%s Y %g dt %g step %d: auto %d its, %d refreshes\n", m.c_str(),
+                                             s.materials.fallback.young, dt, r + 2, st.solver_iterations,
+                                             st.preconditioner_refreshes);
+                        }
+                    std::printf("| %s | %g | %g | %.1f | %.1f | %.1f | %.0f | %.0f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+                                m.c_str(), s.materials.fallback.young, dt, its[0], its[1], its[2], refreshes[1],
+                                refreshes[2], ms[0], ms[1], ms[2], ms[1] / ms[0], ms[2] / ms[0],
+                                ms[2] / std::min(ms[0], ms[1]));
+                } catch (const SimulationError& e) {
+                    std::printf("| %s | %g | %g | failed: %s |  |  |  |  |  |  |  |  |  |  |\n", m.c_str(),
+                                s.materials.fallback.young, dt, std::string(e.what()).substr(0, 90).c_str());
+                }
+                std::fflush(stdout);
+            }
 }
 
 // PCG on an assembled matrix (free dofs where `keep` is 1), from zero, to
@@ -565,6 +623,7 @@ int main(int argc, char** argv) {
         else if (a == "--no-hypre") g_no_hypre = true;
         else if (a == "--threads") g_threads = std::max(1, std::stoi(next()));
         else if (a == "--amg-only") g_amg_only = true;
+        else if (a == "--trace") g_trace = true;
         else if (a == "--amg-levels") g_amg.max_levels = std::max(1, std::stoi(next()));
         else if (a == "--amg-ratio") g_amg.chebyshev_ratio = std::stod(next());
         else if (a == "--amg-weight") g_amg.prolongator_weight = std::stod(next());
@@ -590,6 +649,7 @@ int main(int argc, char** argv) {
     std::printf("%s\n", describe(g_amg).c_str());
     if (parts.find("direct") != std::string::npos) bench_direct(rounds);
     if (parts.find("step") != std::string::npos) bench_steps(meshes, dts, rounds);
+    if (parts.find("run") != std::string::npos) bench_runs(meshes, dts, rounds);
     if (parts.find("matrix") != std::string::npos) {
         // MPI (hypre's) only here: its singleton start leaves a helper process running.
         MPI_Init(&argc, &argv);
