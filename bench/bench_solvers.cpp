@@ -93,9 +93,13 @@ std::string describe(const AmgSettings& a) {
     return buf;
 }
 
-Scene named_scene(const std::string& name) {
-    if (name == "beam") return default_scene();
-    Scene s = step_benchmark_scene(bench::bench_mesh(name), Material{1e5, 0.3, 1000});
+// young > 0: every material's Young's modulus set to it (else the scene's).
+Scene named_scene(const std::string& name, double young = 0) {
+    Scene s = name == "beam" ? default_scene() : step_benchmark_scene(bench::bench_mesh(name), Material{1e5, 0.3, 1000});
+    if (young > 0) {
+        s.materials.fallback.young = young;
+        for (auto& [region, mat] : s.materials.by_region) mat.young = young;
+    }
     return s;
 }
 
@@ -251,11 +255,7 @@ void bench_steps(const std::vector<std::string>& meshes, const std::vector<doubl
     for (const std::string& m : meshes)
         for (double young : g_youngs.empty() ? own : g_youngs)
         for (double dt : dts) {
-            Scene s = named_scene(m);
-            if (young > 0) {
-                s.materials.fallback.young = young;
-                for (auto& [region, mat] : s.materials.by_region) mat.young = young;
-            }
+            const Scene s = named_scene(m, young);
             Scene sb = s, sa = s, sl = s, sd = s;
             for_solve(sb, dt, PreconditionerKind::BlockJacobi);
             for_solve(sd, dt, PreconditionerKind::BlockJacobi);
@@ -316,11 +316,7 @@ void bench_runs(const std::vector<std::string>& meshes, const std::vector<double
     for (const std::string& m : meshes)
         for (double young : g_youngs.empty() ? own : g_youngs)
             for (double dt : dts) {
-                Scene s = named_scene(m);
-                if (young > 0) {
-                    s.materials.fallback.young = young;
-                    for (auto& [region, mat] : s.materials.by_region) mat.young = young;
-                }
+                const Scene s = named_scene(m, young);
                 try {
                     std::vector<std::unique_ptr<Simulator<double>>> sim;
                     for (PreconditionerKind k : kinds) {
@@ -574,7 +570,7 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
                 if (l + 1 < sa.levels()) std::printf(" P %.1f", double(sa.prolongator(l).nonZeros()) / double(sa.dofs(l)));
                 if (l > 0 && l + 1 < sa.levels()) std::printf(" A %.1f", double(sa.matrix(l).nonZeros()) / double(sa.dofs(l)));
             }
-            std::printf(") |  |  |  |  |  |\n");
+            std::printf("; a V-cycle costs %.2f fine products) |  |  |  |  |  |\n", sa.cycle_cost());
             if (!g_no_hypre) {
                 std::printf("| %s | %g | hypre BoomerAMG (systems, nodal) | %.0f | %.2f | %.2f | %.2f | - |\n", m.c_str(),
                             dt, median(its_h), median(setup_h), median(t_h), median(setup_h) + median(t_h));

@@ -420,6 +420,42 @@ TEST(SmoothedAggregation, ThreadsGiveTheSerialBits) {
     }
 }
 
+// cycle_cost (the auto preconditioner's count of a V-cycle's work) from the
+// hierarchy's matrices as the accessors give them: the finest level's
+// 2 x smoothing_steps products, and over the finest matrix's entries on and
+// above the diagonal, each coarser non-coarsest level's products, the
+// restriction and prolongation through each P and the two triangular solves
+// with the dense coarsest factor. The same whichever way P is held (P with
+// one thread, its transpose with more).
+TEST(SmoothedAggregation, CycleCostCountsTheHierarchysEntries) {
+    const BoxSystem sys = box_system(16, 8, 8, 10);
+    const SparseRows& A = sys.A;
+    for (const int steps : {1, 2, 3}) {
+        SCOPED_TRACE(std::to_string(steps) + " smoothing steps");
+        SmoothedAggregation sa;
+        sa.build(A, sys.mesh.X, sys.free_dof, smoother_settings(AmgSmoother::Chebyshev, steps, 100));
+        ASSERT_GE(sa.levels(), 3);
+        const int last = sa.levels() - 1;
+        double coarse = double(sa.dofs(last)) * double(sa.dofs(last));
+        for (int l = 0; l < last; ++l) {
+            coarse += 2.0 * double(sa.prolongator(l).nonZeros());
+            if (l > 0) coarse += 2.0 * steps * double(sa.matrix(l).nonZeros());
+        }
+        index_t free = 0;
+        for (const auto f : sys.free_dof) free += f;
+        const double fine = 0.5 * (double(A.nonZeros()) + 3.0 * double(free));
+        const double expected = 2.0 * steps + coarse / fine;
+        // Within 10 %: the expanded matrices drop the zeros inside blocks,
+        // which the block storage keeps (and reads).
+        EXPECT_GE(sa.cycle_cost(), 0.999 * expected);
+        EXPECT_LE(sa.cycle_cost(), 1.1 * expected);
+        SmoothedAggregation par;
+        par.set_executor(make_executor(ExecutorKind::Pool, 2));
+        par.build(A, sys.mesh.X, sys.free_dof, smoother_settings(AmgSmoother::Chebyshev, steps, 100));
+        EXPECT_EQ(par.cycle_cost(), sa.cycle_cost());
+    }
+}
+
 // The Chebyshev smoother's error propagation E = I - S A is the polynomial
 // q(D^-1 A) = T_m((beta + alpha - 2 lambda) / (beta - alpha)) / T_m(sigma),
 // sigma = (beta + alpha) / (beta - alpha) = (ratio + 1) / (ratio - 1): on

@@ -274,7 +274,7 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--integrator", opts->integrator, "Time integrator (overrides the scene's; docs/dynamics.md)")
         ->check(CLI::IsMember(integrators));
     cmd->add_option("--preconditioner", opts->preconditioner,
-                    "CG's preconditioner: auto (block-Jacobi, AMG once a solve needs more than solver.auto_amg_iterations), block-jacobi or amg (overrides the scene's solver.preconditioner; "
+                    "CG's preconditioner: auto (block-Jacobi, AMG once a solve needs more than solver.auto_amg_iterations, back where AMG costs more), block-jacobi or amg (overrides the scene's solver.preconditioner; "
                     "docs/solvers.md)");
     cmd->add_option("--checkpoint", opts->checkpoint,
                     "Write a checkpoint (the whole state, docs/api.md \"Checkpoints\") to this file at the end "

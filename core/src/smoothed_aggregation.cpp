@@ -480,6 +480,7 @@ struct SmoothedAggregation::Impl {
         mutable Eigen::VectorXd x, b, r, d, t;  // V-cycle work
     };
     AmgSettings settings;
+    double fine_entries = 0;  // the finest matrix's entries on and above the diagonal
     std::vector<Level> level;
     amg::CoarseLdlt coarse;
     std::shared_ptr<const Executor> ex;  // null or one thread: serial
@@ -628,6 +629,7 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
                               ">= 1, chebyshev_ratio > 1, prolongator_weight and strength >= 0, dense_coarsest in [0, 1]");
     Impl& m = *impl_;
     m.settings = settings;
+    m.fine_entries = 0.5 * (double(A.nonZeros()) + 3.0 * double(A.rows()));  // the 3x3 diagonal blocks counted once
     m.level.clear();
     m.level.emplace_back();
     m.level[0].bs = 3;
@@ -758,6 +760,22 @@ void SmoothedAggregation::release_build_data() {
         L.P_tent = SparseRows();
         L.B = Eigen::MatrixXd();
     }
+}
+
+double SmoothedAggregation::cycle_cost() const {
+    const Impl& m = *impl_;
+    if (m.level.empty() || m.fine_entries <= 0) return 0;
+    const double products = 2.0 * m.settings.smoothing_steps;
+    const auto entries = [](const BlockRows& M) { return double(M.col.size()) * M.rb * M.cb; };
+    double coarse = 0;
+    for (std::size_t l = 0; l + 1 < m.level.size(); ++l) {
+        const Impl::Level& L = m.level[l];
+        if (l > 0) coarse += products * entries(L.A);
+        coarse += 2 * (entries(L.P) + entries(L.R));  // one of them is held: restriction and prolongation
+    }
+    const double nc = double(dofs(levels() - 1));
+    coarse += nc * nc;  // the two triangular solves with the dense factor
+    return products + coarse / m.fine_entries;
 }
 
 std::size_t SmoothedAggregation::bytes() const {

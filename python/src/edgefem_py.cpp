@@ -451,7 +451,7 @@ PYBIND11_MODULE(_edgefem, m) {
             "preconditioner", [](const SolverSettings& s) { return std::string(to_string(s.preconditioner)); },
             [](SolverSettings& s, const std::string& name) { s.preconditioner = parse_preconditioner(name); },
             "CG's preconditioner: \"auto\" (default: block-Jacobi, AMG once a solve needs more than "
-            "auto_amg_iterations), \"block-jacobi\" or \"amg\" (docs/solvers.md)")
+            "auto_amg_iterations, back where AMG costs more), \"block-jacobi\" or \"amg\" (docs/solvers.md)")
         .def_readwrite("auto_amg_iterations", &SolverSettings::auto_amg_iterations)
         .def_readwrite("amg_refresh_interval", &SolverSettings::amg_refresh_interval)
         .def_readwrite("cg_tolerance", &SolverSettings::cg_tolerance)

@@ -54,6 +54,7 @@ public:
     }
 
     bool indefinite() const override { return amg_.coarsest_indefinite(); }
+    double iteration_cost() const override { return 1 + amg_.cycle_cost(); }
     int refreshes() const override { return refreshes_; }
 
     // A lagged AMG's solve that has gone far past the iterations after its

@@ -3,14 +3,17 @@
 // iterations (at first SolverSettings::auto_amg_iterations); that solve goes
 // on from its iterate under AMG (set up on the same K). Where block-Jacobi
 // needs few iterations (small steps, soft or small meshes) an iteration of it
-// is ~9-11x cheaper than an AMG one and it wins; past the threshold AMG's
+// is ~6-11x cheaper than an AMG one and it wins; past the threshold AMG's
 // 7-17 iterations win (docs/solvers.md, "Which preconditioner by default").
 // So a step too large for block-Jacobi's iteration limit does not fail on it.
 //
 // AMG then stays while it costs less than block-Jacobi. Costs are counted,
 // not timed, in block-Jacobi CG iterations per decade of residual
-// reduction: an AMG iteration kAmgIteration, a refresh of its operators
-// kRefresh (measured on the shared meshes, docs/solvers.md). Where K changes
+// reduction: an AMG iteration as many as its V-cycle's products with the
+// finest level's matrix, plus one (Preconditioner::iteration_cost, from the
+// hierarchy's sizes: 6.9 on box-1200, 9.2-10.9 on the beam, bunny-4k and
+// bunny-50k, within 0.8-1.2x of the measured ratios), a refresh of its
+// operators kRefresh (measured: 230-430; docs/solvers.md). Where K changes
 // so much from step to step that the AMG refreshes at nearly every step
 // (soft material, long steps), or where its iterations grow (a body folded
 // far from its rest shape), a solve under AMG can cost more than one under
@@ -35,9 +38,8 @@ namespace edgefem::sim {
 
 namespace {
 
-constexpr double kAmgIteration = 10;  // block-Jacobi iterations per AMG iteration (measured 8.6-10.9)
 constexpr double kRefresh = 350;      // block-Jacobi iterations per AMG refresh (measured 230-430)
-constexpr int kWindow = 4;            // AMG solves its cost is judged over
+constexpr int kWindow = 8;            // AMG solves its cost is judged over
 constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
 
 // Decades of residual reduction a solve reached (at least 1).
@@ -95,7 +97,8 @@ public:
             return;
         }
         amg_->solved(iterations, residual);
-        window_[std::size_t(count_ % kWindow)] = {iterations * kAmgIteration + refreshed * kRefresh, d};
+        const double per_iteration = amg_->iteration_cost() / bj_->iteration_cost();
+        window_[std::size_t(count_ % kWindow)] = {iterations * per_iteration + refreshed * kRefresh, d};
         ++count_;
         // Over the last kWindow solves; before there are that many, as soon
         // as the ones so far cost more than block-Jacobi's rate would over

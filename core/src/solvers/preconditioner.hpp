@@ -34,6 +34,10 @@ public:
     // Set-ups that recomputed its operators so far (StepStats::
     // preconditioner_refreshes).
     virtual int refreshes() const { return 0; }
+    // One CG iteration under it, in products with the finest level's
+    // matrix (a count, the same on any machine: the auto preconditioner's
+    // cost model): block-Jacobi 1, AMG 1 + its V-cycle.
+    virtual double iteration_cost() const { return 1; }
     // Makes its next set-up recompute its operators (a lagged one: as if
     // its last solve had found them stale).
     virtual void invalidate() {}

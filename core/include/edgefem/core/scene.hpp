@@ -57,15 +57,16 @@ enum class LinearSolver {
 enum class PreconditionerKind {
     BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap, iterations grow with dt, stiffness and mesh size
     Amg,          // smoothed-aggregation multigrid on the rigid-body modes: set-up per K, few iterations
-    Auto,         // block-Jacobi, AMG from the solve that needs more than auto_amg_iterations on (the default)
+    Auto,         // block-Jacobi, AMG from a solve that needs more than a threshold, back where AMG costs more (the default)
 };
 
 struct SolverSettings {
     LinearSolver linear_solver = LinearSolver::CG;
     PreconditionerKind preconditioner = PreconditionerKind::Auto;
     // Auto: the block-Jacobi CG iterations of one solve past which AMG takes
-    // over for the rest of the run (docs/solvers.md has the measured
-    // crossover). Never with cg_fixed_iterations, or off the host.
+    // over (docs/solvers.md has the measured crossover), at first; where AMG
+    // then costs more, block-Jacobi comes back with the AMG's cost as its
+    // threshold. Never with cg_fixed_iterations, or off the host.
     int auto_amg_iterations = 60;
     // AMG: when its Galerkin operators and smoothers follow a new K (the
     // fine level's products are always the current K's). 0 (default): lagged

@@ -68,6 +68,13 @@ public:
     // prolongators, the near-nullspace): refresh() and apply() go on.
     void release_build_data();
     std::size_t bytes() const;                         // what is held (after release_build_data(): what apply() and refresh() need)
+    // One V-cycle's work in products with the finest level's matrix (its
+    // entries on and above the diagonal, as the per-edge K holds them): the
+    // finest level's own products (2 x smoothing_steps) and the entries the
+    // coarser levels' products, the transfers and the coarsest solve read,
+    // over the finest level's. A count of the hierarchy, the same on any
+    // machine: the auto preconditioner's cost model (docs/solvers.md).
+    double cycle_cost() const;
 
 private:
     struct Impl;
