@@ -617,10 +617,10 @@ struct SmoothedAggregation::Impl {
 SmoothedAggregation::SmoothedAggregation() : impl_(std::make_unique<Impl>()) {}
 SmoothedAggregation::~SmoothedAggregation() = default;
 
-void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& rest,
+void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& positions,
                                 const std::vector<std::uint8_t>& free_dof, const AmgSettings& settings) {
-    if (A.rows() != A.cols() || A.rows() % 3 != 0 || std::size_t(A.rows()) != rest.size() ||
-        free_dof.size() != rest.size())
+    if (A.rows() != A.cols() || A.rows() % 3 != 0 || std::size_t(A.rows()) != positions.size() ||
+        free_dof.size() != positions.size())
         throw InvalidArgument("SmoothedAggregation::build: A must be 3 #V square with 3 #V coordinates and free flags");
     if (settings.max_coarse_dofs < 1 || settings.max_levels < 1 || settings.smoothing_steps < 1 ||
         settings.power_iterations < 1 || !(settings.chebyshev_ratio > 1) || !(settings.prolongator_weight >= 0) ||
@@ -633,7 +633,7 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
     m.level.clear();
     m.level.emplace_back();
     m.level[0].bs = 3;
-    m.level[0].B = rigid_body_modes(rest);
+    m.level[0].B = rigid_body_modes(positions);
     for (std::size_t i = 0; i < free_dof.size(); ++i)
         if (!free_dof[i]) m.level[0].B.row(Eigen::Index(i)).setZero();
     SparseRows Al = A;

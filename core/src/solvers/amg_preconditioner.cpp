@@ -1,6 +1,9 @@
 // The AMG preconditioner: SmoothedAggregation (smoothed_aggregation.hpp) on
 // A = c_m M + c_k K (+ c_b K0). The hierarchy (aggregates, prolongators) is
-// built at the first set-up from the rest shape and the edge graph and kept;
+// built at the first set-up from the body's positions there and the edge
+// graph, and kept until a refresh no longer brings the iterations per decade
+// back within kRebuild of those after the build (then built again on the
+// positions of the K being set up);
 // a refresh assembles A into its fixed pattern (SystemMatrix, whose values
 // are freed again afterwards) and recomputes the Galerkin operators,
 // smoothers and the coarsest factorisation: at every
@@ -50,12 +53,17 @@ public:
             amg_.coarsest_indefinite() || (interval > 0 ? age_ >= interval : stale_ || eager_ > 0 || c != c_);
         if (eager_ > 0) --eager_;
         if (built_ && !due) return;
+        // A refresh that no longer brings the iterations back to those after
+        // the build: the body has moved or deformed far from where the
+        // prolongators were made. Built again on its positions now.
+        if (built_ && built_rate_ > 0 && fresh_rate_ > kRebuild * built_rate_) built_ = false;
         refresh(A, c);
     }
 
     bool indefinite() const override { return amg_.coarsest_indefinite(); }
     double iteration_cost() const override { return 1 + amg_.cycle_cost(); }
     int refreshes() const override { return refreshes_; }
+    int rebuilds() const override { return builds_; }
 
     // A lagged AMG's solve that has gone far past the iterations after its
     // last refresh (3x + 10) refreshes on the A being solved and goes on
@@ -90,12 +98,16 @@ public:
             measure_ = false;
             fresh_rate_ = iterations / decades;
             fresh_its_ = iterations;
+            if (built_rate_ < 0) built_rate_ = fresh_rate_;  // the first since the build
         } else if (fresh_rate_ >= 0 && iterations > 1.5 * fresh_rate_ * decades + 2) {
             stale_ = true;
             if (age_ == 1) eager_ = kEagerSetups;  // the refresh lived one set-up
         }
     }
 
+    // Refreshed at the next set-up (built again there if that refresh then
+    // falls short of the build's iterations: the body may have moved on
+    // while block-Jacobi served, "auto").
     void invalidate() override { stale_ = true; }
 
     // The hierarchy and the last refresh are rebuilt from the points they
@@ -110,6 +122,8 @@ public:
         w.value(fresh_its_);
         w.value(measure_);
         w.value(skip_);
+        w.value(built_rate_);
+        w.value(builds_);
         built_at_.save(w);
         refreshed_at_.save(w);
     }
@@ -124,6 +138,8 @@ public:
         fresh_its_ = r.value<int>("AMG iterations after the refresh");
         measure_ = r.value<bool>("AMG measure flag");
         skip_ = r.value<bool>("AMG skip flag");
+        built_rate_ = r.value<double>("AMG iterations per decade after the build");
+        builds_ = r.value<int>("AMG builds");
         built_at_.load(r, s_.n());
         refreshed_at_.load(r, s_.n());
         if (built_ != built_at_.valid) r.fail("AMG", "built without its point");
@@ -132,7 +148,7 @@ public:
         std::unique_ptr<ElasticOperator<S>> k0;
         built_at_.rebuild(s_, A, k0);
         matrix_.assemble(A);
-        amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host, s_.scene.solver.amg);
+        amg_.build(matrix_.projected(), positions(built_at_), s_.free_host, s_.scene.solver.amg);
         amg_.release_build_data();
         matrix_.release();
         if (!refreshed_at_.valid) return;
@@ -163,10 +179,12 @@ private:
     void refresh(LinearSystem<S>& A, const std::array<double, 3>& c) {
         matrix_.assemble(A);
         if (!built_) {
-            amg_.build(matrix_.projected(), s_.scene.mesh.X, s_.free_host, s_.scene.solver.amg);
-            amg_.release_build_data();
             built_at_.record(s_, A);
+            amg_.build(matrix_.projected(), positions(built_at_), s_.free_host, s_.scene.solver.amg);
+            amg_.release_build_data();
             refreshed_at_.valid = false;
+            built_rate_ = -1;
+            ++builds_;
         } else {
             amg_.refresh(matrix_.projected());
             refreshed_at_.record(s_, A);
@@ -180,6 +198,17 @@ private:
         measure_ = true;
     }
 
+    // The vertices' positions at a point: the rigid-body modes the
+    // hierarchy is built on are those of the body as it is there (a body
+    // rotated from its rest shape has its rest modes rotated too: about the
+    // rest shape they are no near-nullspace of its K).
+    std::vector<double> positions(const TangentPoint<S>& at) const {
+        std::vector<double> x(s_.scene.mesh.X);
+        for (std::size_t i = 0; i < x.size() && i < at.u.size(); ++i) x[i] += double(at.u[i]);
+        return x;
+    }
+
+    static constexpr double kRebuild = 1.5;  // fresh iterations per decade over those after the build that rebuild
     static constexpr int kEagerSetups = 4;  // refreshes in a row after a one-set-up-old refresh was stale
     const SimState<S>& s_;
     std::shared_ptr<const Executor> ex_;  // the back-end's threads (null: serial)
@@ -197,6 +226,8 @@ private:
     bool measure_ = false;       // the next solve after a set-up's refresh measures them
     int eager_ = 0;              // set-ups still to refresh without waiting for a stale solve
     bool skip_ = false;          // the solve under way refreshed part way: it measures nothing
+    double built_rate_ = -1;     // the fresh rate measured after the last build (-1: not yet)
+    int builds_ = 0;             // builds so far (the first and the rebuilds)
     int refreshes_ = 0;          // builds and refreshes so far
     TangentPoint<S> built_at_, refreshed_at_;  // where the hierarchy was built and last refreshed (checkpoints)
 };

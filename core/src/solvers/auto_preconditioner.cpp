@@ -13,7 +13,8 @@
 // finest level's matrix, plus one (Preconditioner::iteration_cost, from the
 // hierarchy's sizes: 6.9 on box-1200, 9.2-10.9 on the beam, bunny-4k and
 // bunny-50k, within 0.8-1.2x of the measured ratios), a refresh of its
-// operators kRefresh (measured: 230-430; docs/solvers.md). Where K changes
+// operators kRefresh (measured: 230-430; docs/solvers.md), a build of its
+// hierarchy kBuild. Where K changes
 // so much from step to step that the AMG refreshes at nearly every step
 // (soft material, long steps), or where its iterations grow (a body folded
 // far from its rest shape), a solve under AMG can cost more than one under
@@ -39,6 +40,7 @@ namespace edgefem::sim {
 namespace {
 
 constexpr double kRefresh = 350;      // block-Jacobi iterations per AMG refresh (measured 230-430)
+constexpr double kBuild = 1200;       // and per build of its hierarchy (measured 3.3-3.7 refreshes)
 constexpr int kWindow = 8;            // AMG solves its cost is judged over
 constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
 
@@ -73,6 +75,7 @@ public:
         active_ = amg_.get();
         active_->setup(A);
         seen_ = amg_->refreshes();
+        seen_builds_ = amg_->rebuilds();
         count_ = 0;
         just_switched_ = true;
     }
@@ -84,8 +87,9 @@ public:
             bj_rate_ = iterations / d;
             return;
         }
-        const int refreshed = amg_->refreshes() - seen_;
+        const int refreshed = amg_->refreshes() - seen_, built = amg_->rebuilds() - seen_builds_;
         seen_ = amg_->refreshes();
+        seen_builds_ = amg_->rebuilds();
         if (just_switched_) {
             // Block-Jacobi would have needed more than its threshold: a lower
             // bound on its cost. Of this solve's AMG part, its set-up is
@@ -98,7 +102,8 @@ public:
         }
         amg_->solved(iterations, residual);
         const double per_iteration = amg_->iteration_cost() / bj_->iteration_cost();
-        window_[std::size_t(count_ % kWindow)] = {iterations * per_iteration + refreshed * kRefresh, d};
+        window_[std::size_t(count_ % kWindow)] = {
+            iterations * per_iteration + (refreshed - built) * kRefresh + built * kBuild, d};
         ++count_;
         // Over the last kWindow solves; before there are that many, as soon
         // as the ones so far cost more than block-Jacobi's rate would over
@@ -124,6 +129,7 @@ public:
         w.value(threshold_);
         w.value(bj_rate_);
         w.value(seen_);
+        w.value(seen_builds_);
         w.value(count_);
         w.value(bj_setups_);
         for (const auto& [c, e] : window_) {
@@ -144,6 +150,7 @@ public:
         if (threshold_ < 1) r.fail("auto preconditioner", "threshold below 1");
         bj_rate_ = r.value<double>("auto preconditioner: block-Jacobi rate");
         seen_ = r.value<int>("auto preconditioner: refreshes seen");
+        seen_builds_ = r.value<int>("auto preconditioner: builds seen");
         count_ = r.value<int>("auto preconditioner: AMG solves");
         if (count_ < 0) r.fail("auto preconditioner", "negative AMG solve count");
         bj_setups_ = r.value<int>("auto preconditioner: block-Jacobi set-ups");
@@ -178,7 +185,7 @@ private:
     double bj_rate_ = 0;         // block-Jacobi's iterations per decade: its last whole solve, or a lower bound
     bool back_ = false;          // the next set-up goes back to block-Jacobi
     bool just_switched_ = false; // the solve under way changed to AMG
-    int seen_ = 0;               // the AMG's refreshes counted so far
+    int seen_ = 0, seen_builds_ = 0;  // the AMG's refreshes and builds counted so far
     int count_ = 0;              // AMG solves since it took over (but the first)
     int bj_setups_ = 0;          // set-ups block-Jacobi served since it took over
     std::array<std::array<double, 2>, kWindow> window_{};  // the last ones' cost and decades

@@ -34,6 +34,9 @@ public:
     // Set-ups that recomputed its operators so far (StepStats::
     // preconditioner_refreshes).
     virtual int refreshes() const { return 0; }
+    // Of those, the ones that built its hierarchy (the AMG's first set-up,
+    // and where the body has moved too far from where it was built).
+    virtual int rebuilds() const { return 0; }
     // One CG iteration under it, in products with the finest level's
     // matrix (a count, the same on any machine: the auto preconditioner's
     // cost model): block-Jacobi 1, AMG 1 + its V-cycle.

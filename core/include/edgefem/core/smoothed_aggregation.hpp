@@ -1,7 +1,8 @@
 // Smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) for
 // elasticity: nodes are 3x3 vertex blocks on the finest level (6x6 on the
-// coarse ones), the near-nullspace is the six rigid-body modes of the rest
-// shape. build() forms the aggregates (greedy, on the matrix's block graph)
+// coarse ones), the near-nullspace is the six rigid-body modes of the
+// positions build() is given (the rest shape, or the body deformed).
+// build() forms the aggregates (greedy, on the matrix's block graph)
 // and the prolongators P = (I - w D^-1 A) P_tent once; refresh() recomputes
 // the Galerkin operators R A P, the smoothers (Chebyshev in D^-1 A or l1
 // block-Jacobi) and the coarsest level's dense LDL^T (its factor in float;
@@ -35,13 +36,13 @@ public:
     ~SmoothedAggregation();
 
     // A: the fine system over 3 #V dofs with the rows and columns of
-    // constrained dofs zero; rest: 3 coordinates per vertex; free_dof: 1 on
+    // constrained dofs zero; positions: 3 coordinates per vertex (where the body is); free_dof: 1 on
     // unknowns. Builds the hierarchy, then refresh(A).
     // Runs apply() and smooth() on `ex` (null: serial). With more than one
     // thread the prolongators are held transposed (P^T instead of P, the
     // same memory): the restriction a gather, the prolongation a scatter.
     void set_executor(std::shared_ptr<const Executor> ex);
-    void build(const SparseRows& A, const std::vector<double>& rest, const std::vector<std::uint8_t>& free_dof,
+    void build(const SparseRows& A, const std::vector<double>& positions, const std::vector<std::uint8_t>& free_dof,
                const AmgSettings& settings = {});
     // Galerkin operators, smoothers and coarsest factorisation for a new A
     // with the pattern build() saw.
