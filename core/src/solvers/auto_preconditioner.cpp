@@ -19,7 +19,8 @@
 // (soft material, long steps), or where its iterations grow (a body folded
 // far from its rest shape), a solve under AMG can cost more than one under
 // block-Jacobi. Block-Jacobi's cost is known from its last whole solve; of
-// the solve it gave up, only that it exceeded the threshold. When the AMG's
+// the solve it gave up, only its rate up to the threshold (the iterations
+// extrapolated to the solve's decades, kept within 1-3x the threshold). When the AMG's
 // cost over its last kWindow solves exceeds that, the next set-up goes back
 // to block-Jacobi, whose threshold becomes the AMG's cost per solve (with a
 // margin): a block-Jacobi solve that stays under it was the cheaper one, one
@@ -70,6 +71,7 @@ public:
 
     void switch_now(LinearSystem<S>& A, int iterations, double residual) override {
         if (on_amg()) return amg_->switch_now(A, iterations, residual);  // its refresh part way
+        switch_decades_ = std::max(0.05, -std::log10(std::max(residual, 1e-300)));
         if (!amg_) amg_ = make_amg(s_);
         else if (bj_setups_ > 1) amg_->invalidate();  // its operators are those of an older K
         active_ = amg_.get();
@@ -91,13 +93,16 @@ public:
         seen_ = amg_->refreshes();
         seen_builds_ = amg_->rebuilds();
         if (just_switched_) {
-            // Block-Jacobi would have needed more than its threshold: a lower
-            // bound on its cost. Of this solve's AMG part, its set-up is
-            // paid, and the AMG is not told it: it started from block-Jacobi's
-            // iterate, so its few iterations are no rate for the lagged
-            // AMG's staleness test to compare later solves with.
+            // Block-Jacobi would have needed more than its threshold: at its
+            // rate so far, threshold x (the decades reached) / (those it had
+            // reached), taken between 1x and 3x the threshold (CG's residual
+            // is not monotone: a stalled start would extrapolate to any
+            // count). Of this solve's AMG part, its set-up is paid, and the
+            // AMG is not told it: it started from block-Jacobi's iterate, so
+            // its few iterations are no rate for the lagged AMG's staleness
+            // test to compare later solves with.
             just_switched_ = false;
-            bj_rate_ = threshold_ / d;
+            bj_rate_ = std::clamp(threshold_ * d / switch_decades_, double(threshold_), 3.0 * threshold_) / d;
             return;
         }
         amg_->solved(iterations, residual);
@@ -185,6 +190,7 @@ private:
     double bj_rate_ = 0;         // block-Jacobi's iterations per decade: its last whole solve, or a lower bound
     bool back_ = false;          // the next set-up goes back to block-Jacobi
     bool just_switched_ = false; // the solve under way changed to AMG
+    double switch_decades_ = 1;  // the decades block-Jacobi had reached in it (not saved: within a solve)
     int seen_ = 0, seen_builds_ = 0;  // the AMG's refreshes and builds counted so far
     int count_ = 0;              // AMG solves since it took over (but the first)
     int bj_setups_ = 0;          // set-ups block-Jacobi served since it took over
