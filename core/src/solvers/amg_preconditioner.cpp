@@ -53,11 +53,10 @@ public:
             amg_.coarsest_indefinite() || (interval > 0 ? age_ >= interval : stale_ || eager_ > 0 || c != c_);
         if (eager_ > 0) --eager_;
         if (built_ && !due) return;
-        // A refresh that no longer brings the iterations back to those after
-        // the build: the body has moved or deformed far from where the
-        // prolongators were made. Built again on its positions now.
-        if (built_ && built_rate_ > 0 && fresh_rate_ > kRebuild * built_rate_) built_ = false;
-        refresh(A, c);
+        // Built again (on the positions now) where a refresh no longer brings
+        // the iterations back to those after the build: the body has moved or
+        // deformed far from where the prolongators were made.
+        refresh(A, c, !built_ || (built_rate_ > 0 && fresh_rate_ > kRebuild * built_rate_));
     }
 
     bool indefinite() const override { return amg_.coarsest_indefinite(); }
@@ -73,9 +72,9 @@ public:
     int switch_after() const override {
         return s_.scene.solver.amg_refresh_interval == 0 && fresh_its_ > 0 ? 3 * fresh_its_ + 10 : 0;
     }
-    void switch_now(LinearSystem<S>& A, int /*iterations*/, double /*residual*/) override {
+    void switch_now(LinearSystem<S>& A, double /*residual*/) override {
         const bool young = age_ == 1;  // stale one set-up after a refresh: K changes that fast
-        refresh(A, {A.c_m(), A.c_k(), A.c_b()});
+        refresh(A, {A.c_m(), A.c_k(), A.c_b()}, false);
         skip_ = true;  // the rest of this solve starts from its iterate: no fresh rate
         if (young) eager_ = kEagerSetups;
     }
@@ -91,7 +90,7 @@ public:
             skip_ = false;
             return;
         }
-        const double decades = std::max(1.0, -std::log10(std::max(residual, 1e-300)));
+        const double decades = residual_decades(residual);
         // The solve right after a set-up's refresh (or, with none measured
         // yet, the first whole solve since).
         if (measure_ && (age_ == 0 || fresh_rate_ < 0)) {
@@ -175,10 +174,11 @@ public:
     std::size_t bytes() const override { return amg_.bytes() + matrix_.bytes(); }
 
 private:
-    // Builds the hierarchy (the first time) or refreshes its operators on A.
-    void refresh(LinearSystem<S>& A, const std::array<double, 3>& c) {
+    // Builds the hierarchy (on the positions now) or refreshes its
+    // operators on A.
+    void refresh(LinearSystem<S>& A, const std::array<double, 3>& c, bool build) {
         matrix_.assemble(A);
-        if (!built_) {
+        if (build) {
             built_at_.record(s_, A);
             amg_.build(matrix_.projected(), positions(built_at_), s_.free_host, s_.scene.solver.amg);
             amg_.release_build_data();

@@ -45,9 +45,6 @@ constexpr double kBuild = 1200;       // and per build of its hierarchy (measure
 constexpr int kWindow = 8;            // AMG solves its cost is judged over
 constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
 
-// Decades of residual reduction a solve reached (at least 1).
-double decades(double residual) { return std::max(1.0, -std::log10(std::max(residual, 1e-300))); }
-
 template <class S>
 class AutoPreconditioner final : public Preconditioner<S> {
 public:
@@ -69,9 +66,9 @@ public:
 
     int switch_after() const override { return on_amg() ? amg_->switch_after() : allowed_ ? threshold_ : 0; }
 
-    void switch_now(LinearSystem<S>& A, int iterations, double residual) override {
-        if (on_amg()) return amg_->switch_now(A, iterations, residual);  // its refresh part way
-        switch_decades_ = std::max(0.05, -std::log10(std::max(residual, 1e-300)));
+    void switch_now(LinearSystem<S>& A, double residual) override {
+        if (on_amg()) return amg_->switch_now(A, residual);  // its refresh part way
+        switch_decades_ = residual_decades(residual, 0.05);
         if (!amg_) amg_ = make_amg(s_);
         else if (bj_setups_ > 1) amg_->invalidate();  // its operators are those of an older K
         active_ = amg_.get();
@@ -83,7 +80,7 @@ public:
     }
 
     void solved(int iterations, double residual) override {
-        const double d = decades(residual);
+        const double d = residual_decades(residual);
         if (!on_amg()) {
             bj_->solved(iterations, residual);
             bj_rate_ = iterations / d;

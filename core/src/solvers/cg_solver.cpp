@@ -34,7 +34,7 @@ public:
         if (may_switch && !res.converged && !res.negative_curvature) {
             // Warm-started from the iterate reached: the residual is relative to
             // the same right side, so the tolerance means what it meant.
-            precond_->switch_now(A, res.iterations, res.residual);
+            precond_->switch_now(A, res.residual);
             const int before = res.iterations;
             res = run(A, b, x, tolerance, max_it - before, 0);
             res.iterations += before;

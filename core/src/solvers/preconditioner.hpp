@@ -4,6 +4,8 @@
 // One implementation per SolverSettings::preconditioner, each in its file.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "simulator/checkpoint_stream.hpp"
@@ -45,13 +47,20 @@ public:
     // its last solve had found them stale).
     virtual void invalidate() {}
     // A preconditioner that gives way to a stronger one part way through a
-    // solve ("auto"): the CG iterations after which a solve that has not
-    // converged changes preconditioner (0: never), and the change itself,
-    // set up on the A being solved, told the iterations run and the
-    // relative residual they reached. The solve goes on from its iterate.
+    // solve ("auto"; the lagged AMG's refresh part way): the CG iterations
+    // after which a solve that has not converged changes preconditioner (0:
+    // never), and the change itself, set up on the A being solved, told the
+    // relative residual reached. The solve goes on from its iterate.
     virtual int switch_after() const { return 0; }
-    virtual void switch_now(LinearSystem<S>& /*A*/, int /*iterations*/, double /*residual*/) {}
+    virtual void switch_now(LinearSystem<S>& /*A*/, double /*residual*/) {}
 };
+
+// Decades of residual reduction a relative residual means (at least
+// `floor`): the unit lagged and automatic preconditioners count iterations
+// in, as Newton's solves ask for different tolerances.
+inline double residual_decades(double residual, double floor = 1) {
+    return std::max(floor, -std::log10(std::max(residual, 1e-300)));
+}
 
 // The scene's SolverSettings::preconditioner.
 template <class S>
