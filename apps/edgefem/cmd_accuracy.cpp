@@ -18,7 +18,9 @@
 //              every 10 ms), then held; no gravity;
 //  shake       box 48x3x3 of 5 mm cells (2592 tets), Y = 1e6, nu = 0.45,
 //              its x = min face moved 20 mm in z in 0.1 s (the same smooth
-//              curve) and held: it swings freely after; no gravity.
+//              curve) and held: it swings freely after; no gravity;
+//  shake-fine  the same beam of 2.5 mm cells (96x6x6, 20,736 tets): the
+//              explicit stable step halves, the motion does not change.
 // The last three are where the explicit stable step is far below the step
 // the motion needs: a fine, thin or nearly incompressible body, whose
 // fastest (pressure) wave crosses a cell in microseconds, moved slowly or
@@ -77,6 +79,11 @@ struct AccScene {
     double duration = 0;         // simulated seconds
     int samples = 0;             // sample times duration * k / samples, k = 1..samples: every 50 ms
     double dt_ref = 0;
+    // The reference's integrator: the trapezoidal rule by Newton, or
+    // velocity Verlet (second order too) where its stable step is below
+    // dt_ref anyway and a Newton step costs hundreds of explicit ones.
+    Integrator ref_integrator = Integrator::Newmark;
+    bool costly = false;  // explicit steps of ms: only the configurations the targets compare (costly_configs)
     std::vector<double> explicit_dts;  // the stiff scenes' explicit and Verlet steps
 };
 
@@ -209,16 +216,31 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
     // in z in 0.1 s, smoothly, then held; no gravity. A smooth 0.1 s move
     // sets the first bending mode swinging and the second hardly at all, so
     // the motion is slow next to the explicit step.
-    if (only.empty() || only == "shake") {
+    auto shaken_beam = [&](const char* name, const char* origin, int refine, std::vector<double> explicit_dts) {
         AccScene d;
-        d.name = "shake";
-        d.mesh_origin = "box 48x3x3, 5 mm";
-        d.scene.mesh = make_box(48, 3, 3, 0.005);
+        d.name = name;
+        d.mesh_origin = origin;
+        d.scene.mesh = make_box(48 * refine, 3 * refine, 3 * refine, 0.005 / refine);
         d.scene.materials = Material{1e6, 0.45, 1000};
         const std::vector<index_t> face = below(d.scene.mesh, 0, coord(d.scene.mesh, 0, false) + 1e-9);
         smooth_drive(d, face, {0, 0, 0.02}, 0.1);
-        d.explicit_dts = {2.5e-5, 4e-5, 5e-5};
+        d.explicit_dts = std::move(explicit_dts);
         out.push_back(std::move(d));
+    };
+    if (only.empty() || only == "shake") shaken_beam("shake", "box 48x3x3, 5 mm", 1, {2.5e-5, 4e-5, 5e-5});
+    // The same beam of 2.5 mm cells: the explicit stable step halves (its
+    // limit lies between 25 and 28 us), the motion and the step it needs
+    // stay.
+    if (only.empty() || only == "shake-fine")
+        shaken_beam("shake-fine", "box 96x6x6, 2.5 mm", 2, {1.25e-5, 2e-5, 2.5e-5});
+    // And of 1.25 mm cells (165,888 tets; explicit stable up to 12.5-14 us):
+    // not in --quick or the full run, only by --scene (~30 min).
+    if (only == "shake-finer") {
+        if (quick) throw Error("accuracy: --scene shake-finer has no --quick run (its explicit rows take minutes each)");
+        shaken_beam("shake-finer", "box 192x12x12, 1.25 mm", 4, {1e-5, 1.25e-5});
+        out.back().ref_integrator = Integrator::Verlet;
+        out.back().dt_ref = 5e-6;
+        out.back().costly = true;
     }
     for (auto& s : out) {
         s.scene.count_inverted_tets = false;
@@ -265,6 +287,15 @@ std::vector<Config> stiff_configs(const std::vector<double>& explicit_dts, bool 
     if (!quick) add(Integrator::Implicit, 1e-3);
     for (Integrator in : {Integrator::NewmarkLinear, Integrator::GeneralizedAlphaLinear, Integrator::Bdf2Linear})
         for (double dt : quick ? std::vector<double>{5e-3} : std::vector<double>{2e-3, 5e-3, 10e-3, 25e-3, 50e-3}) add(in, dt);
+    // A loose CG tolerance: the linearised step is one Newton iteration, so
+    // a solve to 1e-6 buys accuracy the step's own error (0.1-1 %) hides.
+    for (Integrator in : {Integrator::SemiImplicit, Integrator::NewmarkLinear, Integrator::GeneralizedAlphaLinear})
+        for (double dt : quick ? std::vector<double>{5e-3}
+                               : in == Integrator::SemiImplicit ? std::vector<double>{2.5e-4, 1e-3}
+                                                                : std::vector<double>{2e-3, 2.5e-3, 3.125e-3, 5e-3}) {
+            add(in, dt);
+            cs.back().cg_tol = 1e-2;
+        }
     if (!quick)
         for (double dt : {5e-3, 10e-3}) add(Integrator::Newmark, dt);
     label(cs);
@@ -272,6 +303,28 @@ std::vector<Config> stiff_configs(const std::vector<double>& explicit_dts, bool 
 }
 
 std::vector<Config> scene_configs(const AccScene& sc, bool quick);
+
+// A scene whose explicit step costs milliseconds: explicit and Verlet at
+// their steps, the first-order implicit one and the cheapest second-order
+// ones (a loose CG tolerance, from stiff_configs' rows) around 1 % error.
+std::vector<Config> costly_configs(const std::vector<double>& explicit_dts) {
+    std::vector<Config> cs;
+    auto add = [&](Integrator in, double dt, double tol) {
+        Config c;
+        c.integrator = in;
+        c.dt = dt;
+        c.cg_tol = tol;
+        cs.push_back(c);
+    };
+    for (double dt : explicit_dts) add(Integrator::Explicit, dt, 1e-6);
+    add(Integrator::Verlet, explicit_dts.back(), 1e-6);
+    for (double dt : {2.5e-4, 1e-3}) add(Integrator::SemiImplicit, dt, 1e-2);
+    for (Integrator in : {Integrator::NewmarkLinear, Integrator::GeneralizedAlphaLinear})
+        for (double dt : {1.5625e-3, 2e-3, 3.125e-3}) add(in, dt, 1e-2);
+    add(Integrator::GeneralizedAlphaLinear, 2e-3, 1e-6);
+    label(cs);
+    return cs;
+}
 
 // Every configuration's dt divides the time between samples: a sample taken
 // at the step nearest its time, dt / 2 away, would add an error of the
@@ -289,6 +342,7 @@ std::vector<Config> make_configs(const AccScene& sc, bool quick) {
 }
 
 std::vector<Config> scene_configs(const AccScene& sc, bool quick) {
+    if (sc.costly) return costly_configs(sc.explicit_dts);
     if (!sc.explicit_dts.empty()) return stiff_configs(sc.explicit_dts, quick);
     std::vector<Config> cs;
     auto add = [&](Config c) { cs.push_back(c); };
@@ -464,7 +518,8 @@ std::uint64_t scene_hash(const AccScene& sc, const Config& ref) {
     h = fnv1a(s.prescribed_keyframes.data(), s.prescribed_keyframes.size() * sizeof(Keyframe), h);
     const Material& m = s.materials.fallback;
     const double nums[] = {m.young, m.poisson, m.density, s.gravity[0], s.gravity[1], s.gravity[2], sc.duration,
-                           double(sc.samples), ref.dt, s.solver.newton_tolerance, s.solver.cg_tolerance, 4.0 /*format: newmark*/};
+                           double(sc.samples), ref.dt, s.solver.newton_tolerance, s.solver.cg_tolerance,
+                           ref.integrator == Integrator::Newmark ? 4.0 /*format: newmark*/ : 100.0 + double(int(ref.integrator))};
     return fnv1a(nums, sizeof nums, h);
 }
 
@@ -554,7 +609,7 @@ void add_accuracy_command(CLI::App& app) {
     cmd->add_option("--cache", opts->cache, "Folder for the cached reference trajectories (default: build/accuracy-cache)")
         ->check(non_empty_path());
     cmd->add_option("--json", opts->json, "Write the results as JSON to this file")->check(non_empty_path());
-    cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny", "slender", "press", "shake"}));
+    cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny", "slender", "press", "shake", "shake-fine", "shake-finer"}));
     cmd->add_option("--mesh-dir", opts->mesh_dir,
                     "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)")
         ->check(non_empty_path());
@@ -574,7 +629,7 @@ void add_accuracy_command(CLI::App& app) {
         bool first_scene = true;
         for (const AccScene& sc : make_scenes(opts->quick, mesh_folder, opts->scene)) {
             Config ref;
-            ref.integrator = Integrator::Newmark;
+            ref.integrator = sc.ref_integrator;
             ref.dt = sc.dt_ref;
             char hex[20];
             std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(scene_hash(sc, ref)));
@@ -586,8 +641,8 @@ void add_accuracy_command(CLI::App& app) {
             const bool cached = load_reference(path, sc.scene.mesh.X.size(), sc.samples, rt) &&
                                 load_reference(path2, sc.scene.mesh.X.size(), sc.samples, rt2);
             if (!cached) {
-                std::fprintf(stderr, "accuracy: %s: computing the reference (newmark, dt %g and %g, %g s)...\n",
-                             sc.name.c_str(), sc.dt_ref, 2 * sc.dt_ref, sc.duration);
+                std::fprintf(stderr, "accuracy: %s: computing the reference (%s, dt %g and %g, %g s)...\n",
+                             sc.name.c_str(), to_string(sc.ref_integrator), sc.dt_ref, 2 * sc.dt_ref, sc.duration);
                 rt = simulate<double>(sc, ref);
                 if (rt.failed) throw SimulationError("reference for " + sc.name + ": " + rt.message, 0);
                 rt2 = simulate<double>(sc, ref2);
@@ -608,9 +663,10 @@ void add_accuracy_command(CLI::App& app) {
                 floor = std::max(floor, std::sqrt(d2) / 3);
             }
             floor /= uref_max;
-            std::printf("scene %s (%s, %d tets): %g s simulated, reference newmark dt %g & %g extrapolated (%s, %.1f s), "
+            std::printf("scene %s (%s, %d tets): %g s simulated, reference %s dt %g & %g extrapolated (%s, %.1f s), "
                         "ref_error %.3g, reference drift %.3g\n",
-                        sc.name.c_str(), sc.mesh_origin.c_str(), sc.scene.mesh.num_tets(), sc.duration, sc.dt_ref,
+                        sc.name.c_str(), sc.mesh_origin.c_str(), sc.scene.mesh.num_tets(), sc.duration,
+                        to_string(sc.ref_integrator), sc.dt_ref,
                         2 * sc.dt_ref, cached ? "cached" : "computed", ref_wall, floor, ref_drift);
             std::printf("  %-44s %12s %10s %10s %8s %6s\n", "configuration", "wall/sim_s", "error", "drift", "cg/step", "halv");
             if (!first_scene) js << ",";
@@ -618,6 +674,7 @@ void add_accuracy_command(CLI::App& app) {
             js << "\n {\"name\": " << jstr(sc.name) << ", \"mesh\": " << jstr(sc.mesh_origin)
                << ", \"tets\": " << sc.scene.mesh.num_tets() << ", \"duration\": " << jnum(sc.duration)
                << ", \"samples\": " << sc.samples << ", \"dt_ref\": " << jnum(sc.dt_ref)
+               << ", \"reference_integrator\": " << jstr(to_string(sc.ref_integrator))
                << ", \"reference_wall_s\": " << jnum(ref_wall) << ", \"reference_drift\": " << jnum(ref_drift)
                << ", \"reference_error\": " << jnum(floor)
                << ", \"reference_cache\": " << jstr(path) << ", \"configs\": [";
