@@ -11,7 +11,8 @@
 //          from zero by PCG with block-Jacobi, with edgefem's smoothed
 //          aggregation (fine level assembled here) and with hypre's
 //          BoomerAMG (systems AMG, 3 functions, nodal coarsening) on the same
-//          matrix; memory of each preconditioner against the per-edge K's.
+//          matrix; memory of each preconditioner against the per-edge K's;
+//          the SA's whole build, rebuild and refresh, in turn each round.
 //  run     runs of --rounds steps of block-Jacobi, the lagged AMG and `auto`
 //          (the default), a step of each in turn: mean ms per step.
 // Medians over rounds; serial (one thread). Usage:
@@ -505,7 +506,7 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
             };
             // smoothed aggregation on the same matrix (fine level assembled)
             SmoothedAggregation sa;
-            std::vector<double> its_sa, t_sa, setup_sa, refresh_sa;
+            std::vector<double> its_sa, t_sa, setup_sa, refresh_sa, build_sa, rebuild_sa;
             const auto fine = [&](const double* in, double* out) {
                 Eigen::Map<Eigen::VectorXd>(out, Eigen::Index(n)) = A * Eigen::Map<const Eigen::VectorXd>(in, Eigen::Index(n));
             };
@@ -537,6 +538,16 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
                     sa.build(A, s.mesh.X, all.free, g_amg);
                     sa.release_build_data();  // as the simulator's preconditioner
                 } else {
+                    // a whole build (a fresh object), a rebuild (the first
+                    // build's aggregates and patterns) and a refresh in turn
+                    SmoothedAggregation sb;
+                    sb.build(A, s.mesh.X, all.free, g_amg);
+                    sb.release_build_data();
+                    build_sa.push_back(ms_since(t0));
+                    t0 = Clock::now();
+                    sa.rebuild(A, s.mesh.X);
+                    rebuild_sa.push_back(ms_since(t0));
+                    t0 = Clock::now();
                     sa.refresh(A);
                 }
                 (r == 0 ? setup_sa : refresh_sa).push_back(ms_since(t0));
@@ -571,6 +582,11 @@ void bench_matrix(const std::vector<std::string>& meshes, const std::vector<doub
                 if (l > 0 && l + 1 < sa.levels()) std::printf(" A %.1f", double(sa.matrix(l).nonZeros()) / double(sa.dofs(l)));
             }
             std::printf("; a V-cycle costs %.2f fine products) |  |  |  |  |  |\n", sa.cycle_cost());
+            if (!refresh_sa.empty())
+                std::printf("|  |  | (medians over %zu rounds: a whole build %.2f ms, a rebuild %.2f, a refresh %.2f; "
+                            "build/refresh %.2f, rebuild/refresh %.2f) |  |  |  |  |  |\n",
+                            refresh_sa.size(), median(build_sa), median(rebuild_sa), refresh, median(build_sa) / refresh,
+                            median(rebuild_sa) / refresh);
             if (!g_no_hypre) {
                 std::printf("| %s | %g | hypre BoomerAMG (systems, nodal) | %.0f | %.2f | %.2f | %.2f | - |\n", m.c_str(),
                             dt, median(its_h), median(setup_h), median(t_h), median(setup_h) + median(t_h));

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <numeric>
 #include <string>
 
@@ -236,7 +237,176 @@ AmgSettings smoother_settings(AmgSmoother kind, int steps, int max_coarse_dofs, 
     return a;
 }
 
+
+// The system of the box turned rigidly by R (`angle` about the axis (1, 2,
+// 3)) about the origin: the positions R X and the matrix with each 3x3
+// block R A_IJ R^T, in A's pattern (its blocks stored whole).
+struct Turned {
+    std::vector<double> X;
+    SparseRows A;
+};
+Turned turned(const BoxSystem& sys, double angle) {
+    double k[3] = {1, 2, 3}, R[3][3];
+    const double len = std::sqrt(14.0), c = std::cos(angle), s = std::sin(angle);
+    for (double& x : k) x /= len;
+    for (int i = 0; i < 3; ++i)  // Rodrigues: c I + s [k]x + (1 - c) k k^T
+        for (int j = 0; j < 3; ++j) R[i][j] = (i == j ? c : 0.0) + (1 - c) * k[i] * k[j];
+    R[0][1] -= s * k[2];
+    R[0][2] += s * k[1];
+    R[1][0] += s * k[2];
+    R[1][2] -= s * k[0];
+    R[2][0] -= s * k[1];
+    R[2][1] += s * k[0];
+    Turned t{sys.mesh.X, sys.A};
+    for (std::size_t v = 0; v < t.X.size(); v += 3)
+        for (int i = 0; i < 3; ++i) {
+            t.X[v + std::size_t(i)] = 0;
+            for (int j = 0; j < 3; ++j) t.X[v + std::size_t(i)] += R[i][j] * sys.mesh.X[v + std::size_t(j)];
+        }
+    for (Eigen::Index row = 0; row < t.A.rows(); ++row)
+        for (SparseRows::InnerIterator it(t.A, row); it; ++it) {
+            const Eigen::Index I = 3 * (row / 3), J = 3 * (it.col() / 3);
+            const int i = int(row % 3), j = int(it.col() % 3);
+            double v = 0;
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < 3; ++b) v += R[i][a] * sys.A.coeff(I + a, J + b) * R[j][b];
+            it.valueRef() = v;
+        }
+    return t;
+}
+
+// max |a - b| over max |b| (the same shape; b's pattern or a's)
+double max_difference(const SparseRows& a, const SparseRows& b) {
+    const SparseRows d = a - b;
+    double dm = 0, bm = 0;
+    for (Eigen::Index i = 0; i < d.outerSize(); ++i)
+        for (SparseRows::InnerIterator it(d, i); it; ++it) dm = std::max(dm, std::abs(it.value()));
+    for (Eigen::Index i = 0; i < b.outerSize(); ++i)
+        for (SparseRows::InnerIterator it(b, i); it; ++it) bm = std::max(bm, std::abs(it.value()));
+    return dm / bm;
+}
+
 }  // namespace
+
+// rebuild() on a body turned rigidly from where build() was: the strength
+// of connection (|A_IJ|_F) is rotation invariant, so build()'s aggregates
+// are those a fresh build() on the turned body forms, and the rebuilt
+// prolongators, coarse operators and V-cycle are the fresh build's to
+// round-off: the prolongators and coarse operators are held in float, so
+// within 1e-6 of the largest entry (a few float roundings; the
+// prolongators' values are summed in another order), the V-cycle within
+// 1e-5. A refresh alone (the rest shape's prolongators) is far off (the
+// rotation's size), with each smoother.
+TEST(SmoothedAggregation, RebuildOnATurnedBodyIsAFreshBuildThere) {
+    const BoxSystem sys = box_system(16, 8, 8, 10);
+    const Turned t = turned(sys, 0.7);
+    const auto fine = [&](const double* x, double* y) {
+        Eigen::Map<Eigen::VectorXd>(y, t.A.rows()) = t.A * Eigen::Map<const Eigen::VectorXd>(x, t.A.rows());
+    };
+    Eigen::VectorXd r(t.A.rows()), z0(t.A.rows()), z(t.A.rows());
+    for (Eigen::Index i = 0; i < r.size(); ++i) r[i] = sys.free_dof[std::size_t(i)] ? std::sin(1.0 + double(i)) : 0.0;
+    for (const AmgSmoother kind : {AmgSmoother::L1Jacobi, AmgSmoother::Chebyshev}) {
+        SCOPED_TRACE(kind == AmgSmoother::Chebyshev ? "Chebyshev" : "l1 block-Jacobi");
+        const AmgSettings settings = smoother_settings(kind, 2, 100);
+        SmoothedAggregation fresh, re, stale;
+        fresh.build(t.A, t.X, sys.free_dof, settings);
+        re.build(sys.A, sys.mesh.X, sys.free_dof, settings);
+        re.release_build_data();
+        stale.build(sys.A, sys.mesh.X, sys.free_dof, settings);
+        EXPECT_TRUE(re.rebuild(t.A, t.X));
+        stale.refresh(t.A);
+        ASSERT_GE(fresh.levels(), 3);
+        ASSERT_EQ(re.levels(), fresh.levels());
+        for (int l = 0; l + 1 < fresh.levels(); ++l) {
+            const SparseRows P = fresh.prolongator(l);
+            ASSERT_EQ(re.prolongator(l).rows(), P.rows());
+            ASSERT_EQ(re.prolongator(l).cols(), P.cols());
+            EXPECT_LT(max_difference(re.prolongator(l), P), 1e-6) << "level " << l;
+            EXPECT_GT(max_difference(stale.prolongator(l), P), 0.1) << "level " << l;
+            if (l == 0) continue;
+            EXPECT_LT(max_difference(re.matrix(l), fresh.matrix(l)), 1e-6) << "level " << l;
+            EXPECT_GT(max_difference(stale.matrix(l), fresh.matrix(l)), 0.1) << "level " << l;
+        }
+        fresh.apply(r.data(), z0.data(), fine);
+        re.apply(r.data(), z.data(), fine);
+        EXPECT_LT((z - z0).norm(), 1e-5 * z0.norm());
+        EXPECT_EQ(re.cycle_cost(), fresh.cycle_cost());
+    }
+}
+
+// rebuild() is one thread's fixed order, the V-cycle's passes bitwise the
+// serial ones: on 2 threads (P held transposed) the rebuilt hierarchy's
+// V-cycle, prolongators and coarse operators are the serial bits, and a
+// second rebuild on the same input gives them again.
+TEST(SmoothedAggregation, RebuildGivesTheSameBitsOnAnyThreadCount) {
+    const BoxSystem sys = box_system(16, 8, 8, 10);
+    const Turned t = turned(sys, 1.1);
+    const auto fine = [&](const double* x, double* y) {
+        Eigen::Map<Eigen::VectorXd>(y, t.A.rows()) = t.A * Eigen::Map<const Eigen::VectorXd>(x, t.A.rows());
+    };
+    Eigen::VectorXd r(t.A.rows());
+    for (Eigen::Index i = 0; i < r.size(); ++i) r[i] = sys.free_dof[std::size_t(i)] ? std::cos(0.3 * double(i)) : 0.0;
+    const auto same = [](const SparseRows& a, const SparseRows& b) {
+        return a.nonZeros() == b.nonZeros() && a.rows() == b.rows() &&
+               std::memcmp(a.valuePtr(), b.valuePtr(), sizeof(double) * std::size_t(a.nonZeros())) == 0 &&
+               std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), sizeof(int) * std::size_t(a.nonZeros())) == 0;
+    };
+    SmoothedAggregation serial, par;
+    par.set_executor(make_executor(ExecutorKind::Pool, 2));
+    for (SmoothedAggregation* sa : {&serial, &par}) {
+        sa->build(sys.A, sys.mesh.X, sys.free_dof, smoother_settings(AmgSmoother::Chebyshev, 2, 100));
+        sa->release_build_data();
+        sa->rebuild(t.A, t.X);
+    }
+    Eigen::VectorXd z0(r.size()), z(r.size());
+    serial.apply(r.data(), z0.data(), fine);
+    for (int again = 0; again < 2; ++again) {
+        SCOPED_TRACE(again ? "rebuilt twice" : "rebuilt once");
+        par.apply(r.data(), z.data(), fine);
+        EXPECT_EQ(0, std::memcmp(z.data(), z0.data(), sizeof(double) * std::size_t(z.size())));
+        for (int l = 0; l + 1 < serial.levels(); ++l) {
+            EXPECT_TRUE(same(par.prolongator(l), serial.prolongator(l))) << "level " << l;
+            if (l > 0) {
+                EXPECT_TRUE(same(par.matrix(l), serial.matrix(l))) << "level " << l;
+            }
+        }
+        par.rebuild(t.A, t.X);
+    }
+}
+
+// rebuild() before build(), with positions of another size, or with a
+// matrix of another pattern (an entry more, or another size) is an error
+// that names it, and leaves the hierarchy as it was.
+TEST(SmoothedAggregation, RebuildOnAnotherPatternOrPositionsIsAnError) {
+    const BoxSystem sys = box_system(8, 4, 4, 5);
+    const auto fails = [](const std::function<void()>& f, const std::string& what) {
+        try {
+            f();
+            ADD_FAILURE() << "no error for " << what;
+        } catch (const InvalidArgument& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    };
+    SmoothedAggregation sa;
+    fails([&] { sa.rebuild(sys.A, sys.mesh.X); }, "build() first");
+    sa.build(sys.A, sys.mesh.X, sys.free_dof, smoother_settings(AmgSmoother::Chebyshev, 2, 100));
+    const SparseRows P = sa.prolongator(0);
+    std::vector<double> X = sys.mesh.X;
+    X.pop_back();
+    fails([&] { sa.rebuild(sys.A, X); }, "positions has " + std::to_string(X.size()) + " coordinates");
+    SparseRows wider = sys.A;
+    const Eigen::Index n = wider.rows();
+    wider.coeffRef(n - 1, 0) = wider.coeffRef(0, n - 1) = 1e-3;  // the box's far corners: no edge
+    ASSERT_GT(wider.nonZeros(), sys.A.nonZeros());
+    fails([&] { sa.rebuild(wider, sys.mesh.X); }, "A's pattern");
+    const BoxSystem other = box_system(8, 4, 5, 5);
+    fails([&] { sa.rebuild(other.A, other.mesh.X); }, "coordinates");
+    std::vector<double> Xo = other.mesh.X;
+    Xo.resize(sys.mesh.X.size());
+    fails([&] { sa.rebuild(other.A, Xo); }, "A's pattern");
+    EXPECT_EQ(max_difference(sa.prolongator(0), P), 0);
+    EXPECT_TRUE(sa.rebuild(sys.A, sys.mesh.X));
+}
 
 TEST(SmoothedAggregation, VCycleIsSymmetricAndPositiveWithEachSmoother) {
     const BoxSystem sys = box_system(12, 6, 6, 10);

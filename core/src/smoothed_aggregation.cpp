@@ -440,6 +440,133 @@ struct BlockRows {
 };
 
 
+
+// The nodes of each aggregate, in increasing order (agg: each node's
+// aggregate, count of them): nodes [start[a], start[a + 1]) of `node`.
+struct Members {
+    std::vector<index_t> start, node;
+    Members(const std::vector<index_t>& agg, index_t count) : start(std::size_t(count) + 1, 0), node(agg.size()) {
+        for (const index_t a : agg) ++start[std::size_t(a) + 1];
+        for (std::size_t a = 0; a < std::size_t(count); ++a) start[a + 1] += start[a];
+        std::vector<index_t> next(start.begin(), start.end() - 1);
+        for (std::size_t i = 0; i < agg.size(); ++i) node[std::size_t(next[std::size_t(agg[i])]++)] = index_t(i);
+    }
+    index_t count() const { return index_t(start.size() - 1); }
+};
+
+// The tentative prolongator of near-nullspace B (bs-dof nodes) on the
+// aggregates: per aggregate, its nodes' rows of B = Q R (thin QR); Q
+// written per node (Qn: bs x 6 row-major per node, the node's block of
+// P_tent, zero on dofs that are not free where `free` is given), R as the
+// aggregate's 6 rows of the coarse near-nullspace Bc.
+void tentative_blocks(const Eigen::MatrixXd& B, int bs, const Members& members, const std::uint8_t* free,
+                      std::vector<double>& Qn, Eigen::MatrixXd& Bc) {
+    const std::size_t w = std::size_t(bs) * kModes;
+    Qn.assign(members.node.size() * w, 0.0);
+    Bc = Eigen::MatrixXd::Zero(Eigen::Index(members.count()) * kModes, kModes);
+    std::vector<double> Ba, Q;
+    double R[kModes * kModes];
+    for (index_t a = 0; a < members.count(); ++a) {
+        const index_t* mem = &members.node[std::size_t(members.start[std::size_t(a)])];
+        const std::size_t size = std::size_t(members.start[std::size_t(a) + 1] - members.start[std::size_t(a)]);
+        const std::size_t rows = size * std::size_t(bs);
+        Ba.assign(rows * kModes, 0.0);  // column-major
+        for (std::size_t k = 0; k < size; ++k)
+            for (int r = 0; r < bs; ++r)
+                for (int c = 0; c < kModes; ++c)
+                    Ba[std::size_t(c) * rows + k * std::size_t(bs) + std::size_t(r)] = B(Eigen::Index(mem[k]) * bs + r, c);
+        thin_qr(Ba, rows, Q, R);
+        for (int r = 0; r < kModes; ++r)
+            for (int c = 0; c < kModes; ++c) Bc(Eigen::Index(a) * kModes + r, c) = R[r * kModes + c];
+        for (std::size_t v = 0; v < size; ++v)
+            for (int r = 0; r < bs; ++r) {
+                const std::size_t dof = std::size_t(mem[v]) * std::size_t(bs) + std::size_t(r);
+                if (free && !free[dof]) continue;
+                for (int c = 0; c < kModes; ++c) Qn[dof * kModes + std::size_t(c)] = Q[std::size_t(c) * rows + v * std::size_t(bs) + std::size_t(r)];
+            }
+    }
+}
+
+// A's sparsity pattern (its rows' column indices), hashed (FNV-1a).
+std::uint64_t pattern_hash(const SparseRows& A) {
+    std::uint64_t h = 1469598103934665603ull;
+    const auto mix = [&](std::uint64_t v) { h = (h ^ v) * 1099511628211ull; };
+    mix(std::uint64_t(A.rows()));
+    mix(std::uint64_t(A.cols()));
+    for (Eigen::Index i = 0; i < A.outerSize(); ++i) {
+        for (SparseRows::InnerIterator it(A, i); it; ++it) mix(std::uint64_t(it.col()));
+        mix(~std::uint64_t(0));
+    }
+    return h;
+}
+
+
+// P = (I - f D^-1 A) P_tent, numerically into P's block pattern (BS x 6
+// blocks, kept from build(); no product that allocates): P_tent's block of
+// node J is Qn's (tentative_blocks), in column agg[J]; D^-1 by its inverse
+// blocks. Block row I's A P_tent is summed per aggregate in a scratch row,
+// then D_I^-1 times it subtracted from P_tent's block. False where a
+// nonzero block falls outside the pattern (build() found it zero).
+template <int BS>
+bool smooth_into(const SparseRows& A, const std::vector<double>& Dinv, const std::vector<double>& Qn,
+                 const std::vector<index_t>& agg, double f, BlockRows& P) {
+    constexpr std::size_t bs = BS, w = std::size_t(BS) * kModes;
+    std::vector<int> slot(std::size_t(P.cols / kModes), -1), cols;
+    std::vector<double> s;
+    double block[w];
+    const auto open = [&](std::size_t a) {
+        if (slot[a] >= 0) return;
+        slot[a] = int(cols.size());
+        cols.push_back(int(a));
+        if (s.size() < cols.size() * w) s.resize(cols.size() * w);
+        std::fill_n(s.begin() + std::ptrdiff_t((cols.size() - 1) * w), w, 0.0);
+    };
+    for (std::size_t I = 0; I + 1 < P.start.size(); ++I) {
+        cols.clear();
+        open(std::size_t(agg[I]));
+        for (std::size_t r = 0; r < bs; ++r)
+            for (SparseRows::InnerIterator it(A, Eigen::Index(I * bs + r)); it; ++it) {
+                const std::size_t J = std::size_t(it.col()) / bs, j = std::size_t(it.col()) % bs;
+                const std::size_t a = std::size_t(agg[J]);
+                open(a);
+                double* sa = &s[std::size_t(slot[a]) * w + r * kModes];
+                const double* q = &Qn[(J * bs + j) * kModes];
+                const double v = it.value();
+                for (int c = 0; c < kModes; ++c) sa[c] += v * q[c];
+            }
+        const double* d = &Dinv[I * bs * bs];
+        const double* qi = &Qn[I * w];
+        const int* first = P.col.data() + P.start[I];
+        const int* last = P.col.data() + P.start[I + 1];
+        std::fill(P.val.begin() + std::ptrdiff_t(std::size_t(P.start[I]) * w),
+                  P.val.begin() + std::ptrdiff_t(std::size_t(P.start[I + 1]) * w), 0.0f);
+        bool covered = true;
+        for (std::size_t t = 0; t < cols.size(); ++t) {
+            const double* st = &s[t * w];
+            const bool own = cols[t] == agg[I];
+            bool zero = true;
+            for (std::size_t r = 0; r < bs; ++r)
+                for (int c = 0; c < kModes; ++c) {
+                    double ds = 0;
+                    for (std::size_t k = 0; k < bs; ++k) ds += d[r * bs + k] * st[k * kModes + std::size_t(c)];
+                    const double v = (own ? qi[r * kModes + std::size_t(c)] : 0.0) - f * ds;
+                    block[r * kModes + std::size_t(c)] = v;
+                    zero = zero && v == 0;
+                }
+            const int* pos = std::lower_bound(first, last, cols[t]);
+            if (pos != last && *pos == cols[t]) {
+                float* out = &P.val[std::size_t(pos - P.col.data()) * w];
+                for (std::size_t e = 0; e < w; ++e) out[e] = float(block[e]);
+            } else if (!zero) {
+                covered = false;
+            }
+        }
+        for (const int a : cols) slot[std::size_t(a)] = -1;
+        if (!covered) return false;
+    }
+    return true;
+}
+
 }  // namespace
 
 Eigen::MatrixXd rigid_body_modes(const std::vector<double>& p) {
@@ -474,6 +601,7 @@ struct SmoothedAggregation::Impl {
         BlockRows P, R;
         SparseRows P_tent;     // before smoothing (build only; release_build_data() frees it)
         Eigen::MatrixXd B;     // near-nullspace, dofs x 6
+        std::vector<index_t> agg;  // not the coarsest: each node's aggregate (its block column of P; rebuild())
         std::vector<double> Minv;  // the smoother's inverse blocks (D^-1, or l1 block-Jacobi's)
         double lambda = 1;     // Chebyshev: the largest eigenvalue of D^-1 A
         amg::GalerkinProduct galerkin;  // level >= 1: forms its operator from the level above's at each refresh
@@ -483,6 +611,8 @@ struct SmoothedAggregation::Impl {
     double fine_entries = 0;  // the finest matrix's entries on and above the diagonal
     std::vector<Level> level;
     amg::CoarseLdlt coarse;
+    std::vector<std::uint8_t> free;  // build()'s free dofs and its A's pattern (hashed), for rebuild()
+    std::uint64_t pattern = 0;
     std::shared_ptr<const Executor> ex;  // null or one thread: serial
 
     bool threaded() const { return ex && ex->threads() > 1; }
@@ -577,6 +707,59 @@ struct SmoothedAggregation::Impl {
         }
     }
 
+    // refresh(), and with positions rebuild()'s prolongators first: level
+    // by level, on its operator Al (the caller's A, then the Galerkin
+    // operator of the prolongator just made), the near-nullspace's QR per
+    // aggregate (the coarse level's near-nullspace) and P's values into its
+    // pattern, smoothed with the D^-1 and largest eigenvalue of D^-1 Al that
+    // the Chebyshev smoother uses too. False where a prolongator's value
+    // falls outside its pattern (then nothing is consistent: build again).
+    bool update(const SparseRows& A, const std::vector<double>* positions) {
+        const SparseRows* Al = &A;
+        SparseRows Acur, Anext;  // the Galerkin operator of level l, in double while the next is formed
+        Eigen::MatrixXd B, Bc;   // rebuild: the near-nullspace of level l, of level l + 1
+        std::vector<double> Qn, Dinv;
+        if (positions) {
+            B = rigid_body_modes(*positions);
+            for (std::size_t i = 0; i < free.size(); ++i)
+                if (!free[i]) B.row(Eigen::Index(i)).setZero();
+        }
+        for (std::size_t l = 0; l < level.size(); ++l) {
+            Level& L = level[l];
+            if (l > 0) {
+                BlockRows scratch;
+                const BlockRows& P = prolongator(level[l - 1], scratch);
+                const amg::BlockRowsView view{P.start.size() - 1, P.rb, P.cb, P.start.data(), P.col.data(), P.val.data()};
+                L.galerkin(*Al, view, std::size_t(P.cols / P.cb), Anext);
+                Acur.swap(Anext);
+                Al = &Acur;
+            }
+            if (l + 1 == level.size()) {
+                L.Minv.assign(std::size_t(Al->rows()) * std::size_t(L.bs), 0.0);  // sizes only
+                if (!coarse.factor(*Al)) throw Error("AMG: the coarsest level's factorisation failed (a zero pivot)");
+                break;
+            }
+            if (l > 0) L.A.assign(*Al, L.bs, L.bs);
+            const bool cheb = settings.smoother == AmgSmoother::Chebyshev;
+            L.Minv = block_inverse(*Al, L.bs, !cheb);
+            if (cheb) L.lambda = largest_eigenvalue(*Al, L.Minv, L.bs, settings.power_iterations);
+            if (!positions) continue;
+            if (!cheb) Dinv = block_inverse(*Al, L.bs, false);
+            const std::vector<double>& D = cheb ? L.Minv : Dinv;
+            const double rho = cheb ? L.lambda : largest_eigenvalue(*Al, D, L.bs, settings.power_iterations);
+            BlockRows P = L.P.rows > 0 ? std::move(L.P) : L.R.transposed();
+            L.R = BlockRows();
+            tentative_blocks(B, L.bs, Members(L.agg, index_t(P.cols / kModes)), l == 0 ? free.data() : nullptr, Qn, Bc);
+            const double f = settings.prolongator_weight / rho;
+            const bool covered = L.bs == 3 ? smooth_into<3>(*Al, D, Qn, L.agg, f, P) : smooth_into<6>(*Al, D, Qn, L.agg, f, P);
+            L.P = std::move(P);
+            hold(L);
+            if (!covered) return false;
+            B.swap(Bc);
+        }
+        return true;
+    }
+
     // out = A_l in: the caller's product on the finest level.
     auto product(std::size_t l, const std::function<void(const double*, double*)>& fine) const {
         return [this, l, &fine](const double* in, double* out) {
@@ -630,6 +813,8 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
     Impl& m = *impl_;
     m.settings = settings;
     m.fine_entries = 0.5 * (double(A.nonZeros()) + 3.0 * double(A.rows()));  // the 3x3 diagonal blocks counted once
+    m.free = free_dof;
+    m.pattern = pattern_hash(A);
     m.level.clear();
     m.level.emplace_back();
     m.level[0].bs = 3;
@@ -650,33 +835,15 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
         const std::vector<index_t> agg = aggregate(node_graph(Al, bs, m.level.size() == 1 ? 0.0 : settings.strength), count);
         if (Eigen::Index(count) * kModes >= Al.rows()) break;  // no coarsening left
         // Tentative prolongator: per aggregate, B's rows = Q R (thin QR).
-        std::vector<std::vector<index_t>> members{std::size_t(count)};
-        for (std::size_t i = 0; i < agg.size(); ++i) members[std::size_t(agg[i])].push_back(index_t(i));
+        std::vector<double> Qn;
+        Eigen::MatrixXd Bc;
+        tentative_blocks(L.B, bs, Members(agg, count), m.level.size() == 1 ? free_dof.data() : nullptr, Qn, Bc);
         std::vector<Eigen::Triplet<double>> t;
-        Eigen::MatrixXd Bc = Eigen::MatrixXd::Zero(Eigen::Index(count) * kModes, kModes);
-        std::vector<double> Ba, Q;
-        double R[kModes * kModes];
-        for (index_t a = 0; a < count; ++a) {
-            const auto& mem = members[std::size_t(a)];
-            const std::size_t rows = mem.size() * std::size_t(bs);
-            Ba.assign(rows * kModes, 0.0);  // column-major
-            for (std::size_t k = 0; k < mem.size(); ++k)
-                for (int r = 0; r < bs; ++r)
-                    for (int c = 0; c < kModes; ++c)
-                        Ba[std::size_t(c) * rows + k * std::size_t(bs) + std::size_t(r)] =
-                            L.B(Eigen::Index(mem[k]) * bs + r, c);
-            thin_qr(Ba, rows, Q, R);
-            for (int r = 0; r < kModes; ++r)
-                for (int c = 0; c < kModes; ++c) Bc(Eigen::Index(a) * kModes + r, c) = R[r * kModes + c];
-            for (std::size_t v = 0; v < mem.size(); ++v)
-                for (int r = 0; r < bs; ++r) {
-                    const std::size_t row = v * std::size_t(bs) + std::size_t(r);
-                    const int dof = mem[v] * bs + r;
-                    if (m.level.size() == 1 && !free_dof[std::size_t(dof)]) continue;
-                    for (int c = 0; c < kModes; ++c)
-                        if (const double q = Q[std::size_t(c) * rows + row]; q != 0) t.emplace_back(dof, a * kModes + c, q);
-                }
-        }
+        for (std::size_t dof = 0; dof < std::size_t(Al.rows()); ++dof)
+            for (int c = 0; c < kModes; ++c)
+                if (const double q = Qn[dof * kModes + std::size_t(c)]; q != 0)
+                    t.emplace_back(int(dof), agg[dof / std::size_t(bs)] * kModes + c, q);
+        L.agg = agg;
         L.P_tent.resize(Al.rows(), Eigen::Index(count) * kModes);
         L.P_tent.setFromTriplets(t.begin(), t.end());
         // Smoothed: P = (I - w / rho D^-1 A) P_tent (w = 4/3 by default).
@@ -697,30 +864,28 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
 }
 
 void SmoothedAggregation::refresh(const SparseRows& A) {
+    if (impl_->level.empty()) throw InvalidArgument("SmoothedAggregation::refresh: build() first");
+    impl_->update(A, nullptr);
+}
+
+bool SmoothedAggregation::rebuild(const SparseRows& A, const std::vector<double>& positions) {
     Impl& m = *impl_;
-    if (m.level.empty()) throw InvalidArgument("SmoothedAggregation::refresh: build() first");
-    const SparseRows* Al = &A;
-    SparseRows Acur, Anext;  // the Galerkin operator of level l, in double while the next is formed
-    for (std::size_t l = 0; l < m.level.size(); ++l) {
-        Impl::Level& L = m.level[l];
-        if (l > 0) {
-            BlockRows scratch;
-            const BlockRows& P = Impl::prolongator(m.level[l - 1], scratch);
-            const amg::BlockRowsView view{P.start.size() - 1, P.rb, P.cb, P.start.data(), P.col.data(), P.val.data()};
-            L.galerkin(*Al, view, std::size_t(P.cols / P.cb), Anext);
-            Acur.swap(Anext);
-            Al = &Acur;
-        }
-        if (l + 1 < m.level.size()) {
-            if (l > 0) L.A.assign(*Al, L.bs, L.bs);
-            const bool cheb = m.settings.smoother == AmgSmoother::Chebyshev;
-            L.Minv = block_inverse(*Al, L.bs, !cheb);
-            if (cheb) L.lambda = largest_eigenvalue(*Al, L.Minv, L.bs, m.settings.power_iterations);
-        } else {
-            L.Minv.assign(std::size_t(Al->rows()) * std::size_t(L.bs), 0.0);  // sizes only
-            if (!m.coarse.factor(*Al)) throw Error("AMG: the coarsest level's factorisation failed (a zero pivot)");
-        }
+    if (m.level.empty()) throw InvalidArgument("SmoothedAggregation::rebuild: build() first");
+    if (positions.size() != m.free.size())
+        throw InvalidArgument("SmoothedAggregation::rebuild: positions has " + std::to_string(positions.size()) +
+                              " coordinates, build() had " + std::to_string(m.free.size()));
+    if (A.rows() != A.cols() || std::size_t(A.rows()) != m.free.size() || pattern_hash(A) != m.pattern)
+        throw InvalidArgument("SmoothedAggregation::rebuild: A's pattern (" + std::to_string(A.rows()) + " x " +
+                              std::to_string(A.cols()) + ", " + std::to_string(A.nonZeros()) +
+                              " entries) is not the one build() saw");
+    for (auto& L : m.level) {  // build()'s; not those of the positions now
+        L.P_tent = SparseRows();
+        L.B = Eigen::MatrixXd();
     }
+    if (m.update(A, &positions)) return true;
+    const std::vector<std::uint8_t> free = m.free;
+    build(A, positions, free, m.settings);
+    return false;
 }
 
 void SmoothedAggregation::set_executor(std::shared_ptr<const Executor> ex) {
@@ -786,8 +951,9 @@ std::size_t SmoothedAggregation::bytes() const {
     std::size_t b = 0;
     for (const auto& L : impl_->level)
         b += L.A.bytes() + L.P.bytes() + L.R.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
-             L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t) + L.galerkin.bytes();
-    b += impl_->coarse.bytes();
+             L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t) + L.galerkin.bytes() +
+             L.agg.size() * sizeof(index_t);
+    b += impl_->coarse.bytes() + impl_->free.size();
     return b;
 }
 

@@ -2,8 +2,9 @@
 // A = c_m M + c_k K (+ c_b K0). The hierarchy (aggregates, prolongators) is
 // built at the first set-up from the body's positions there and the edge
 // graph, and kept until a refresh no longer brings the iterations per decade
-// back within kRebuild of those after the build (then built again on the
-// positions of the K being set up);
+// back within kRebuild of those after the build (then rebuilt on the
+// positions of the K being set up: SmoothedAggregation::rebuild, the first
+// build's aggregates and patterns, the prolongators' values anew);
 // a refresh assembles A into its fixed pattern (SystemMatrix, whose values
 // are freed again afterwards) and recomputes the Galerkin operators,
 // smoothers and the coarsest factorisation: at every
@@ -124,6 +125,7 @@ public:
         w.value(built_rate_);
         w.value(builds_);
         built_at_.save(w);
+        rebuilt_at_.save(w);
         refreshed_at_.save(w);
     }
     void load(CheckpointReader& r, LinearSystem<S>& A) override {
@@ -140,8 +142,10 @@ public:
         built_rate_ = r.value<double>("AMG iterations per decade after the build");
         builds_ = r.value<int>("AMG builds");
         built_at_.load(r, s_.n());
+        rebuilt_at_.load(r, s_.n());
         refreshed_at_.load(r, s_.n());
         if (built_ != built_at_.valid) r.fail("AMG", "built without its point");
+        if (rebuilt_at_.valid && !built_) r.fail("AMG", "rebuilt but not built");
         A_ = &A;
         if (!built_) return;
         std::unique_ptr<ElasticOperator<S>> k0;
@@ -150,6 +154,12 @@ public:
         amg_.build(matrix_.projected(), positions(built_at_), s_.free_host, s_.scene.solver.amg);
         amg_.release_build_data();
         matrix_.release();
+        if (rebuilt_at_.valid) {
+            rebuilt_at_.rebuild(s_, A, k0);
+            matrix_.assemble(A);
+            amg_.rebuild(matrix_.projected(), positions(rebuilt_at_));
+            matrix_.release();
+        }
         if (!refreshed_at_.valid) return;
         refreshed_at_.rebuild(s_, A, k0);
         matrix_.assemble(A);
@@ -178,16 +188,22 @@ private:
     // operators on A.
     void refresh(LinearSystem<S>& A, const std::array<double, 3>& c, bool build) {
         matrix_.assemble(A);
-        if (build) {
+        if (build && !built_) {
             built_at_.record(s_, A);
             amg_.build(matrix_.projected(), positions(built_at_), s_.free_host, s_.scene.solver.amg);
             amg_.release_build_data();
+            rebuilt_at_.valid = refreshed_at_.valid = false;
+        } else if (build) {  // on the first build's aggregates and patterns: about a refresh's cost
+            rebuilt_at_.record(s_, A);
+            amg_.rebuild(matrix_.projected(), positions(rebuilt_at_));
             refreshed_at_.valid = false;
-            built_rate_ = -1;
-            ++builds_;
         } else {
             amg_.refresh(matrix_.projected());
             refreshed_at_.record(s_, A);
+        }
+        if (build) {
+            built_rate_ = -1;
+            ++builds_;
         }
         matrix_.release();  // assembled again at the next refresh
         ++refreshes_;
@@ -229,7 +245,9 @@ private:
     double built_rate_ = -1;     // the fresh rate measured after the last build (-1: not yet)
     int builds_ = 0;             // builds so far (the first and the rebuilds)
     int refreshes_ = 0;          // builds and refreshes so far
-    TangentPoint<S> built_at_, refreshed_at_;  // where the hierarchy was built and last refreshed (checkpoints)
+    // Where the hierarchy was built (its aggregates), last rebuilt (valid:
+    // since the build) and last refreshed (checkpoints).
+    TangentPoint<S> built_at_, rebuilt_at_, refreshed_at_;
 };
 
 }  // namespace

@@ -47,6 +47,22 @@ public:
     // Galerkin operators, smoothers and coarsest factorisation for a new A
     // with the pattern build() saw.
     void refresh(const SparseRows& A);
+    // The hierarchy made again for a new A of build()'s pattern and the body
+    // at `positions` (3 #V), on build()'s aggregates and the patterns of its
+    // prolongators and coarse operators: the near-nullspace (the positions'
+    // rigid-body modes on build()'s free dofs), per aggregate its QR (the
+    // tentative prolongator, the coarse near-nullspace), the smoothed
+    // prolongators' values formed into their patterns, then refresh(A)'s
+    // work (the Chebyshev smoother's D^-1 and largest eigenvalue are those
+    // the prolongator smoother uses). About a refresh's cost where build()
+    // costs 3-4 (docs/solvers.md). The aggregates of build() come from A's
+    // strong couplings then: a fresh build() on a deformed body may group
+    // differently (on a body turned rigidly it does not). Returns false
+    // where a prolongator's value fell outside build()'s pattern (a block
+    // build() found exactly zero): then it has built afresh. Another pattern
+    // or positions of another size is an error that names it. Frees the
+    // tentative prolongators and near-nullspace (as release_build_data()).
+    bool rebuild(const SparseRows& A, const std::vector<double>& positions);
     // z = one V-cycle applied to r (n each, zero on constrained dofs);
     // fine(x, y): y = A x with constrained entries of y zero.
     void apply(const double* r, double* z, const std::function<void(const double*, double*)>& fine) const;
@@ -66,7 +82,9 @@ public:
     const Eigen::MatrixXd& near_nullspace(int level) const;  // dofs(level) x 6
     SparseRows matrix(int level) const;                // 1 <= level < levels() - 1 (level 0: the caller's; the coarsest: factorised)
     // Frees what only build() and the accessors above need (the tentative
-    // prolongators, the near-nullspace): refresh() and apply() go on.
+    // prolongators, the near-nullspace): refresh(), rebuild() and apply() go
+    // on (rebuild() keeps each level's aggregates and build()'s free dofs:
+    // 4 bytes a node and 1 a dof).
     void release_build_data();
     std::size_t bytes() const;                         // what is held (after release_build_data(): what apply() and refresh() need)
     // One V-cycle's work in products with the finest level's matrix (its
