@@ -19,6 +19,11 @@ struct EnergySample {
     double kinetic = 0, elastic = 0;
     double gravity = 0;  // -m g.u (the constant -m g.X left out: only differences count)
     double load = 0;     // f_ext.u with the step's f_ext: its change is the external work
+    // Where constraints move: kinetic, gravity and load over the
+    // constrained vertices (the free part is the total less these), and
+    // f.(u_c(t_end) - u_c(t_start)), the constrained dofs' forces times
+    // their move (half of it is the constraints' work on the body).
+    double c_kinetic = 0, c_gravity = 0, c_load = 0, c_work = 0;
     double total() const { return kinetic + elastic + gravity; }
     double magnitude() const { return kinetic + std::abs(elastic) + std::abs(gravity) + std::abs(load); }
 };
@@ -33,12 +38,14 @@ public:
     // guard's force pass at the end of the last step when u is unchanged
     // since (then f is current too and the step skips its force pass), else
     // from a force pass here. Edits the application made between steps are
-    // thereby part of the starting energy, not of the step's gain.
-    EnergySample start();
+    // thereby part of the starting energy, not of the step's gain. With
+    // `moved`, also the constrained vertices' terms (EnergySample::c_*).
+    EnergySample start(double t_end, bool moved);
 
     // Whether a step from the current state to t_end moves a fixed or
     // prescribed vertex (a prescribed ramp, or a vertex the application
-    // displaced): the constraint's work is unknown, so the guard skips it.
+    // displaced). Such a step's gain is the free vertices' energy change
+    // less the constraints' work, f_c . du_c by the trapezoidal rule.
     bool constraints_move(double t_end) const;
 
     // After a failed step: its force passes (Newton's iterates) have
@@ -65,6 +72,7 @@ public:
 
 private:
     EnergySample sample(double W) const;
+    void constrained(EnergySample& e, const S* u_from, double fraction) const;
 
     SimState<S>& s_;
     BackendVector<S> u_evaluated_;  // the u that f, the operator's state and W_evaluated_ belong to

@@ -29,7 +29,7 @@ void StepControl<S>::advance(double T, int depth) {
         bool moved = false;
         if (guard) {
             moved = guard_.constraints_move(s_.time + T);
-            start = guard_.start();
+            start = guard_.start(s_.time + T, moved);
         }
         const std::optional<double> W_end = integrator_.step(T);
         s_.check_finite(s_.step + 1);

@@ -196,6 +196,30 @@ public:
             },
             AddArrays{});
     }
+    std::array<double, 4> constrained_sums(const S* u, const S* v, const S* fext, const S* f, const S* u_from,
+                                           const double* mass, const std::array<double, 3>& g, const ConstraintView& c,
+                                           double fraction) const override {
+        const double g0 = g[0], g1 = g[1], g2 = g[2];
+        const index_t* vertex = c.vertex;
+        const double* disp = c.disp;
+        return launch_.reduce(
+            c.count, std::array<double, 4>{},
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
+                const auto d = [](S x) { return double(x); };
+                std::array<double, 4> s{};
+                for (std::size_t k = lo; k < hi; ++k) {
+                    const std::size_t a = std::size_t(vertex[k]), i = 3 * a;
+                    s[0] += ops::kinetic_term(mass[a], d(v[i]), d(v[i + 1]), d(v[i + 2]));
+                    s[1] += ops::gravity_term(mass[a], g0, g1, g2, d(u[i]), d(u[i + 1]), d(u[i + 2]));
+                    for (std::size_t j = 0; j < 3; ++j) {
+                        s[2] += d(fext[i + j]) * d(u[i + j]);
+                        s[3] += d(f[i + j]) * (fraction * disp[3 * k + j] - d(u_from[i + j]));
+                    }
+                }
+                return std::array<double, 4>{0.5 * s[0], -s[1], s[2], s[3]};
+            },
+            AddArrays{});
+    }
     double damping_work(const S* u, const S* u0, const S* v, const S* v0, const double* mass, double w_new,
                         double w_old, std::size_t n) const override {
         return launch_.sum(n, [=] EDGEFEM_LAMBDA(std::size_t i) {

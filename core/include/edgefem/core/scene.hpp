@@ -102,9 +102,10 @@ struct SolverSettings {
     // external forces' work and of what mass damping removed, by more than
     // (max_energy_growth - 1) x the largest kinetic + elastic energy seen: a
     // body released at rest then never holds more than this factor of its
-    // energy. Not checked: steps that move a constrained vertex (their work
-    // is unknown); measured but never failed: semi-implicit steps with a
-    // fixed CG budget (StepStats::energy_growth). 0 disables it; otherwise
+    // energy. Steps that move a constrained vertex are checked on the free
+    // vertices, the constraints' work counted as supplied; linearised steps
+    // with a fixed CG budget fail only past 1000x (a blow-up), a lesser gain
+    // is measured (StepStats::energy_growth). 0 disables it; otherwise
     // >= 1. docs/scenes.md ("Solver settings") says why 10.
     double max_energy_growth = 10;
     // A step that ends with inverted tets (negative volume) fails with a

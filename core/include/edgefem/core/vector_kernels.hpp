@@ -149,6 +149,12 @@ public:
     // {kinetic energy, -g.(M u), f_ext.u}; mass per vertex.
     virtual std::array<double, 3> energy_sums(const S* u, const S* v, const S* fext, const double* mass,
                                               const std::array<double, 3>& g, std::size_t n) const = 0;
+    // energy_sums over the constrained vertices only, and the work
+    // f.(fraction disp - u_from) of f on their move from u_from to their
+    // targets: {kinetic, -g.(M u), f_ext.u, work}.
+    virtual std::array<double, 4> constrained_sums(const S* u, const S* v, const S* fext, const S* f, const S* u_from,
+                                                   const double* mass, const std::array<double, 3>& g,
+                                                   const ConstraintView& c, double fraction) const = 0;
     // Sum over the dofs of m (u - u0) (w_new v + w_old v0) (damping_work_term),
     // mass per vertex: mass damping's work over a step, divided by alpha.
     virtual double damping_work(const S* u, const S* u0, const S* v, const S* v0, const double* mass, double w_new,
