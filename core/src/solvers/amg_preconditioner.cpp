@@ -10,8 +10,8 @@
 // smoothers and the coarsest factorisation: at every
 // amg_refresh_interval-th K, or (0) lagged while CG's iterations per decade
 // of residual reduction stay within 1.5x (+ 2 iterations) of those after
-// the last refresh, the coefficients (the step size) are unchanged and the
-// coarsest level was definite (an indefinite
+// the last refresh; under either, also where the coefficients (the step
+// size) changed or the coarsest level was indefinite (an indefinite
 // one is reported as negative curvature: Preconditioner::indefinite). A
 // refresh that is stale in the very next solve (K changes that fast: soft
 // material, long steps) makes the next kEagerSetups set-ups refresh
@@ -48,10 +48,16 @@ public:
         const int interval = s_.scene.solver.amg_refresh_interval;
         const std::array<double, 3> c{A.c_m(), A.c_k(), A.c_b()};
         ++age_;
-        // An indefinite coarsest level is refreshed at the next set-up under
-        // any interval: that set-up is the definite K the step falls back to.
-        const bool due =
-            amg_.coarsest_indefinite() || (interval > 0 ? age_ >= interval : stale_ || eager_ > 0 || c != c_);
+        // Under any interval, refreshed at the next set-up where the coarsest
+        // level was indefinite (that set-up is the definite K the step falls
+        // back to) or where the coefficients changed (another step size, or
+        // BDF2's first step after its backward Euler one): a smoother made
+        // for c_m M + K is no smoother for 2.25 c_m M + K. D^-1 A's spectrum
+        // then reaches past the Chebyshev bound, the V-cycle is indefinite
+        // and CG stalled (r.z < 0 from its first iteration; 2,000 iterations
+        // at a relative residual of 3e-4).
+        const bool due = amg_.coarsest_indefinite() || c != c_ ||
+                         (interval > 0 ? age_ >= interval : stale_ || eager_ > 0);
         if (eager_ > 0) --eager_;
         if (built_ && !due) return;
         // Built again (on the positions now) where a refresh no longer brings
