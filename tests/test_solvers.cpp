@@ -293,8 +293,7 @@ double max_difference(const SparseRows& a, const SparseRows& b) {
 // are those a fresh build() on the turned body forms, and the rebuilt
 // prolongators, coarse operators and V-cycle are the fresh build's to
 // round-off: the prolongators and coarse operators are held in float, so
-// within 1e-6 of the largest entry (a few float roundings; the
-// prolongators' values are summed in another order), the V-cycle within
+// within 1e-6 of the largest entry (a few float roundings), the V-cycle within
 // 1e-5. A refresh alone (the rest shape's prolongators) is far off (the
 // rotation's size), with each smoother.
 TEST(SmoothedAggregation, RebuildOnATurnedBodyIsAFreshBuildThere) {
@@ -411,6 +410,39 @@ TEST(SmoothedAggregation, RebuildOnAnotherPatternOrPositionsIsAnError) {
     fails([&] { sa.rebuild(other.A, Xo); }, "A's pattern");
     EXPECT_EQ(max_difference(sa.prolongator(0), P), 0);
     EXPECT_TRUE(sa.rebuild(sys.A, sys.mesh.X));
+}
+
+// Each prolongator is its tentative one smoothed by its level's operator A_l:
+// P = (I - f D^-1 A_l) P_tent, D the 3x3 (coarser: 6x6) diagonal blocks of
+// A_l, one f > 0 per level (w / rho, rho the power iteration's estimate of
+// D^-1 A_l's largest eigenvalue). Checked as D (P_tent - P) = f A_l P_tent
+// with Eigen's sparse products (the formula in another form than the row
+// by row one that builds P), with each smoother, within the float rounding
+// of the stored P and A_l.
+TEST(SmoothedAggregation, ProlongatorsAreTheTentativeOnesSmoothed) {
+    const BoxSystem sys = box_system(16, 8, 8, 10);
+    for (const AmgSmoother kind : {AmgSmoother::Chebyshev, AmgSmoother::L1Jacobi}) {
+        SCOPED_TRACE(kind == AmgSmoother::Chebyshev ? "Chebyshev" : "l1-Jacobi");
+        SmoothedAggregation amg;
+        amg.build(sys.A, sys.mesh.X, sys.free_dof, smoother_settings(kind, 2, 100));
+        ASSERT_GE(amg.levels(), 3);
+        SparseRows Al = sys.A;
+        for (int l = 0; l + 1 < amg.levels(); ++l) {
+            const Eigen::Index bs = l == 0 ? 3 : 6;
+            std::vector<Eigen::Triplet<double>> t;
+            for (Eigen::Index k = 0; k < Al.outerSize(); ++k)
+                for (SparseRows::InnerIterator it(Al, k); it; ++it)
+                    if (it.row() / bs == it.col() / bs) t.emplace_back(int(it.row()), int(it.col()), it.value());
+            SparseRows D(Al.rows(), Al.cols());
+            D.setFromTriplets(t.begin(), t.end());
+            const SparseRows Pt = amg.tentative(l), P = amg.prolongator(l);
+            const SparseRows X = D * SparseRows(Pt - P), Y = Al * Pt;
+            const double f = X.cwiseProduct(Y).sum() / Y.squaredNorm();
+            EXPECT_GT(f, 0) << "level " << l;
+            EXPECT_LT(SparseRows(X - f * Y).norm(), 1e-5 * X.norm()) << "level " << l;
+            if (l + 2 < amg.levels()) Al = amg.matrix(l + 1);
+        }
+    }
 }
 
 TEST(SmoothedAggregation, VCycleIsSymmetricAndPositiveWithEachSmoother) {

@@ -174,20 +174,6 @@ std::vector<double> block_inverse(const SparseRows& A, int bs, bool l1) {
     return inv;
 }
 
-// The block-diagonal sparse matrix of inverse blocks (block_inverse's).
-SparseRows block_diagonal(const std::vector<double>& Dinv, int bs, Eigen::Index n) {
-    std::vector<Eigen::Triplet<double>> t;
-    const std::size_t bb = std::size_t(bs * bs);
-    for (std::size_t i = 0; i < Dinv.size() / bb; ++i)
-        for (int r = 0; r < bs; ++r)
-            for (int c = 0; c < bs; ++c)
-                if (const double v = Dinv[i * bb + std::size_t(r * bs + c)]; v != 0)
-                    t.emplace_back(int(i) * bs + r, int(i) * bs + c, v);
-    SparseRows D(n, n);
-    D.setFromTriplets(t.begin(), t.end());
-    return D;
-}
-
 // y = f D^-1 v + keep y, D^-1 given by its bs x bs inverse blocks (keep 0:
 // y overwritten).
 // Nodes [first, last) only (block_apply_range), or all of them.
@@ -436,6 +422,28 @@ struct BlockRows {
         M.setFromTriplets(t.begin(), t.end());
         return M;
     }
+    // Drops the blocks whose entries are all zero (assign() stores none).
+    void drop_zero_blocks() {
+        const std::size_t w = std::size_t(rb) * std::size_t(cb);
+        std::size_t kept = 0;
+        int first = 0;
+        for (std::size_t I = 0; I + 1 < start.size(); ++I) {
+            const int last = start[I + 1];
+            for (int k = first; k < last; ++k) {
+                const float* v = &val[std::size_t(k) * w];
+                if (std::all_of(v, v + w, [](float x) { return x == 0; })) continue;
+                col[kept] = col[std::size_t(k)];
+                std::copy(v, v + w, val.begin() + std::ptrdiff_t(kept * w));
+                ++kept;
+            }
+            first = last;
+            start[I + 1] = int(kept);
+        }
+        col.resize(kept);
+        val.resize(kept * w);
+        col.shrink_to_fit();
+        val.shrink_to_fit();
+    }
     std::size_t bytes() const { return start.size() * sizeof(int) + col.size() * sizeof(int) + val.size() * sizeof(float); }
 };
 
@@ -500,9 +508,56 @@ std::uint64_t pattern_hash(const SparseRows& A) {
     return h;
 }
 
+// The block pattern of P = (I - f D^-1 A) P_tent (values zero): block row
+// I (node I of bs dofs) has a block in the column of each aggregate that I
+// or a node A couples it to belongs to (agg: each node's aggregate, count
+// of them).
+BlockRows prolongator_pattern(const SparseRows& A, int bs, const std::vector<index_t>& agg, index_t count) {
+    BlockRows P;
+    P.rows = A.rows();
+    P.cols = Eigen::Index(count) * kModes;
+    P.rb = bs;
+    P.cb = kModes;
+    const std::size_t nodes = agg.size();
+    P.start.assign(nodes + 1, 0);
+    std::vector<char> seen(std::size_t(count), 0);
+    std::vector<int> here;
+    for (std::size_t I = 0; I < nodes; ++I) {
+        here.assign(1, int(agg[I]));
+        seen[std::size_t(agg[I])] = 1;
+        for (int r = 0; r < bs; ++r)
+            for (SparseRows::InnerIterator it(A, Eigen::Index(I) * bs + r); it; ++it) {
+                const std::size_t a = std::size_t(agg[std::size_t(it.col() / bs)]);
+                if (!seen[a]) {
+                    seen[a] = 1;
+                    here.push_back(int(a));
+                }
+            }
+        std::sort(here.begin(), here.end());
+        for (const int a : here) seen[std::size_t(a)] = 0;
+        P.col.insert(P.col.end(), here.begin(), here.end());
+        P.start[I + 1] = int(P.col.size());
+    }
+    P.val.assign(P.col.size() * std::size_t(bs) * kModes, 0.0f);
+    return P;
+}
+
+// P_tent as a sparse matrix, from its node blocks Qn (tentative_blocks).
+SparseRows tentative_matrix(const std::vector<double>& Qn, const std::vector<index_t>& agg, int bs, index_t count) {
+    std::vector<Eigen::Triplet<double>> t;
+    const std::size_t dofs = agg.size() * std::size_t(bs);
+    for (std::size_t dof = 0; dof < dofs; ++dof)
+        for (int c = 0; c < kModes; ++c)
+            if (const double q = Qn[dof * kModes + std::size_t(c)]; q != 0)
+                t.emplace_back(int(dof), agg[dof / std::size_t(bs)] * kModes + c, q);
+    SparseRows P(Eigen::Index(dofs), Eigen::Index(count) * kModes);
+    P.setFromTriplets(t.begin(), t.end());
+    return P;
+}
 
 // P = (I - f D^-1 A) P_tent, numerically into P's block pattern (BS x 6
-// blocks, kept from build(); no product that allocates): P_tent's block of
+// blocks, prolongator_pattern's, kept after build(); no product that
+// allocates): P_tent's block of
 // node J is Qn's (tentative_blocks), in column agg[J]; D^-1 by its inverse
 // blocks. Block row I's A P_tent is summed per aggregate in a scratch row,
 // then D_I^-1 times it subtracted from P_tent's block. False where a
@@ -707,17 +762,23 @@ struct SmoothedAggregation::Impl {
         }
     }
 
-    // refresh(), and with positions rebuild()'s prolongators first: level
-    // by level, on its operator Al (the caller's A, then the Galerkin
-    // operator of the prolongator just made), the near-nullspace's QR per
-    // aggregate (the coarse level's near-nullspace) and P's values into its
-    // pattern, smoothed with the D^-1 and largest eigenvalue of D^-1 Al that
-    // the Chebyshev smoother uses too. False where a prolongator's value
-    // falls outside its pattern (then nothing is consistent: build again).
-    bool update(const SparseRows& A, const std::vector<double>* positions) {
+    // build() (`grow`), rebuild() (positions) and refresh(), level by level
+    // on its operator Al (the caller's A, then the Galerkin operator of the
+    // prolongator just made):
+    //  - grow: Al's aggregates and P's block pattern (grow_level), or Al is
+    //    the coarsest;
+    //  - the smoother's D^-1 and (Chebyshev) the largest eigenvalue of
+    //    D^-1 Al;
+    //  - with positions, the prolongator: the near-nullspace's QR per
+    //    aggregate (the coarse level's near-nullspace) and P's values into
+    //    its pattern (smooth_into), smoothed with the same D^-1 and
+    //    eigenvalue; grow then drops P's zero blocks.
+    // False where a prolongator's value falls outside its pattern (then
+    // nothing is consistent: build again).
+    bool update(const SparseRows& A, const std::vector<double>* positions, bool grow = false) {
         const SparseRows* Al = &A;
         SparseRows Acur, Anext;  // the Galerkin operator of level l, in double while the next is formed
-        Eigen::MatrixXd B, Bc;   // rebuild: the near-nullspace of level l, of level l + 1
+        Eigen::MatrixXd B, Bc;   // build and rebuild: the near-nullspace of level l, of level l + 1
         std::vector<double> Qn, Dinv;
         if (positions) {
             B = rigid_body_modes(*positions);
@@ -725,15 +786,16 @@ struct SmoothedAggregation::Impl {
                 if (!free[i]) B.row(Eigen::Index(i)).setZero();
         }
         for (std::size_t l = 0; l < level.size(); ++l) {
-            Level& L = level[l];
             if (l > 0) {
                 BlockRows scratch;
                 const BlockRows& P = prolongator(level[l - 1], scratch);
                 const amg::BlockRowsView view{P.start.size() - 1, P.rb, P.cb, P.start.data(), P.col.data(), P.val.data()};
-                L.galerkin(*Al, view, std::size_t(P.cols / P.cb), Anext);
+                level[l].galerkin(*Al, view, std::size_t(P.cols / P.cb), Anext);
                 Acur.swap(Anext);
                 Al = &Acur;
             }
+            if (grow) grow_level(l, *Al);
+            Level& L = level[l];
             if (l + 1 == level.size()) {
                 L.Minv.assign(std::size_t(Al->rows()) * std::size_t(L.bs), 0.0);  // sizes only
                 if (!coarse.factor(*Al)) throw Error("AMG: the coarsest level's factorisation failed (a zero pivot)");
@@ -749,15 +811,43 @@ struct SmoothedAggregation::Impl {
             const double rho = cheb ? L.lambda : largest_eigenvalue(*Al, D, L.bs, settings.power_iterations);
             BlockRows P = L.P.rows > 0 ? std::move(L.P) : L.R.transposed();
             L.R = BlockRows();
-            tentative_blocks(B, L.bs, Members(L.agg, index_t(P.cols / kModes)), l == 0 ? free.data() : nullptr, Qn, Bc);
-            const double f = settings.prolongator_weight / rho;
+            const index_t count = index_t(P.cols / kModes);
+            tentative_blocks(B, L.bs, Members(L.agg, count), l == 0 ? free.data() : nullptr, Qn, Bc);
+            const double f = settings.prolongator_weight / rho;  // w / rho (w = 4/3 by default)
             const bool covered = L.bs == 3 ? smooth_into<3>(*Al, D, Qn, L.agg, f, P) : smooth_into<6>(*Al, D, Qn, L.agg, f, P);
+            if (grow) {  // build()'s, for the accessors (release_build_data() frees them)
+                P.drop_zero_blocks();
+                L.P_tent = tentative_matrix(Qn, L.agg, L.bs, count);
+                L.B = B;
+                level[l + 1].B = Bc;
+            }
             L.P = std::move(P);
             hold(L);
             if (!covered) return false;
             B.swap(Bc);
         }
         return true;
+    }
+
+    // build(): level l's aggregates, on the strong couplings of its operator
+    // Al (the finest level's on the whole edge graph), and its prolongator's
+    // block pattern, and a level l + 1 of 6-mode nodes after it; nothing
+    // where l is to be the coarsest (Al small enough, the levels or the
+    // density at their limits, or no coarsening left).
+    void grow_level(std::size_t l, const SparseRows& Al) {
+        const int bs = level[l].bs;
+        if (Al.rows() <= settings.max_coarse_dofs || int(level.size()) >= settings.max_levels) return;
+        if (l > 0 && settings.dense_coarsest > 0 &&
+            double(Al.nonZeros()) >= settings.dense_coarsest * double(Al.rows()) * double(Al.rows()))
+            return;
+        index_t count = 0;
+        std::vector<index_t> agg = aggregate(node_graph(Al, bs, l == 0 ? 0.0 : settings.strength), count);
+        if (Eigen::Index(count) * kModes >= Al.rows()) return;
+        level[l].P = prolongator_pattern(Al, bs, agg, count);
+        level[l].R = BlockRows();
+        level[l].agg = std::move(agg);
+        level.emplace_back();
+        level.back().bs = kModes;
     }
 
     // out = A_l in: the caller's product on the finest level.
@@ -818,49 +908,8 @@ void SmoothedAggregation::build(const SparseRows& A, const std::vector<double>& 
     m.level.clear();
     m.level.emplace_back();
     m.level[0].bs = 3;
-    m.level[0].B = rigid_body_modes(positions);
-    for (std::size_t i = 0; i < free_dof.size(); ++i)
-        if (!free_dof[i]) m.level[0].B.row(Eigen::Index(i)).setZero();
-    SparseRows Al = A;
-    while (true) {
-        Impl::Level& L = m.level.back();
-        const int bs = L.bs;
-        if (Al.rows() <= settings.max_coarse_dofs || int(m.level.size()) >= settings.max_levels) break;
-        if (m.level.size() > 1 && settings.dense_coarsest > 0 &&
-            double(Al.nonZeros()) >= settings.dense_coarsest * double(Al.rows()) * double(Al.rows()))
-            break;
-        index_t count = 0;
-        // The finest level aggregates on the whole edge graph; coarser ones
-        // on their strong couplings only.
-        const std::vector<index_t> agg = aggregate(node_graph(Al, bs, m.level.size() == 1 ? 0.0 : settings.strength), count);
-        if (Eigen::Index(count) * kModes >= Al.rows()) break;  // no coarsening left
-        // Tentative prolongator: per aggregate, B's rows = Q R (thin QR).
-        std::vector<double> Qn;
-        Eigen::MatrixXd Bc;
-        tentative_blocks(L.B, bs, Members(agg, count), m.level.size() == 1 ? free_dof.data() : nullptr, Qn, Bc);
-        std::vector<Eigen::Triplet<double>> t;
-        for (std::size_t dof = 0; dof < std::size_t(Al.rows()); ++dof)
-            for (int c = 0; c < kModes; ++c)
-                if (const double q = Qn[dof * kModes + std::size_t(c)]; q != 0)
-                    t.emplace_back(int(dof), agg[dof / std::size_t(bs)] * kModes + c, q);
-        L.agg = agg;
-        L.P_tent.resize(Al.rows(), Eigen::Index(count) * kModes);
-        L.P_tent.setFromTriplets(t.begin(), t.end());
-        // Smoothed: P = (I - w / rho D^-1 A) P_tent (w = 4/3 by default).
-        const std::vector<double> Dinv = block_inverse(Al, bs, false);
-        const SparseRows DinvA = block_diagonal(Dinv, bs, Al.rows()) * Al;
-        const double rho = largest_eigenvalue(Al, Dinv, bs, settings.power_iterations);
-        const SparseRows P = L.P_tent - (settings.prolongator_weight / rho) * SparseRows(DinvA * L.P_tent);
-        L.P.assign(P, bs, kModes);
-        const SparseRows Pf = L.P.expand();  // the rounded P, as refresh() and apply() use it
-        m.hold(L);
-        SparseRows Ac = SparseRows(Pf.transpose()) * Al * Pf;
-        m.level.emplace_back();
-        m.level.back().bs = kModes;
-        m.level.back().B = Bc;
-        Al = std::move(Ac);
-    }
-    refresh(A);
+    if (!m.update(A, &positions, true))
+        throw Error("AMG: a prolongator's value outside the pattern build() found for it");  // cannot happen
 }
 
 void SmoothedAggregation::refresh(const SparseRows& A) {

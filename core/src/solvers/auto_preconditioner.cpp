@@ -42,7 +42,7 @@ namespace {
 
 constexpr double kRefresh = 350;      // block-Jacobi iterations per AMG refresh (measured 230-430)
 constexpr double kBuild = 420;        // and per rebuild of its hierarchy (SmoothedAggregation::rebuild: measured
-                                      // 1.13-1.36 refreshes; the first, whole build, 3.1-4.4, is paid at the switch)
+                                      // 1.13-1.36 refreshes; the first, whole build, 1.7-1.8, is paid at the switch)
 constexpr int kWindow = 8;            // AMG solves its cost is judged over
 constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
 

@@ -2,8 +2,11 @@
 // elasticity: nodes are 3x3 vertex blocks on the finest level (6x6 on the
 // coarse ones), the near-nullspace is the six rigid-body modes of the
 // positions build() is given (the rest shape, or the body deformed).
-// build() forms the aggregates (greedy, on the matrix's block graph)
-// and the prolongators P = (I - w D^-1 A) P_tent once; refresh() recomputes
+// build() forms the aggregates (greedy, on the matrix's block graph) and
+// the prolongators P = (I - w D^-1 A) P_tent once, level by level on the
+// operator the level above's prolongator gives (the values as rebuild()
+// forms them, into a block pattern found from the aggregates and A's
+// couplings, its zero blocks then dropped); refresh() recomputes
 // the Galerkin operators R A P, the smoothers (Chebyshev in D^-1 A or l1
 // block-Jacobi) and the coarsest level's dense LDL^T (its factor in float;
 // core/src/amg/coarse_ldlt.hpp) for a new A of the same pattern; apply() runs one symmetric
@@ -37,7 +40,7 @@ public:
 
     // A: the fine system over 3 #V dofs with the rows and columns of
     // constrained dofs zero; positions: 3 coordinates per vertex (where the body is); free_dof: 1 on
-    // unknowns. Builds the hierarchy, then refresh(A).
+    // unknowns. Builds the hierarchy with refresh(A)'s operators and smoothers.
     // Runs apply() and smooth() on `ex` (null: serial). With more than one
     // thread the prolongators are held transposed (P^T instead of P, the
     // same memory): the restriction a gather, the prolongation a scatter.
@@ -55,7 +58,7 @@ public:
     // prolongators' values formed into their patterns, then refresh(A)'s
     // work (the Chebyshev smoother's D^-1 and largest eigenvalue are those
     // the prolongator smoother uses). About a refresh's cost where build()
-    // costs 3-4 (docs/solvers.md). The aggregates of build() come from A's
+    // costs 1.6-1.9 (docs/solvers.md). The aggregates of build() come from A's
     // strong couplings then: a fresh build() on a deformed body may group
     // differently (on a body turned rigidly it does not). Returns false
     // where a prolongator's value fell outside build()'s pattern (a block
