@@ -73,7 +73,8 @@ struct SolverSettings {
     // while CG's iterations per decade of residual reduction stay within
     // 1.5x (+ 2 iterations) of the solve's right after the last refresh, and
     // on every change of the step size; N >= 1: every N-th
-    // K (1: every K). docs/solvers.md has the measurements.
+    // K (1: every K) and on every change of the step size. docs/solvers.md
+    // has the measurements.
     int amg_refresh_interval = 0;
     AmgSettings amg;  // the hierarchy and smoother (amg_settings.hpp); C++ only
     double cg_tolerance = 1e-6;   // relative residual |r| / |b| of the projected system
