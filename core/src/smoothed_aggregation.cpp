@@ -796,6 +796,7 @@ struct SmoothedAggregation::Impl {
             }
             if (grow) grow_level(l, *Al);
             Level& L = level[l];
+            if (grow) L.B = B;  // build()'s, for the accessors (release_build_data() frees them)
             if (l + 1 == level.size()) {
                 L.Minv.assign(std::size_t(Al->rows()) * std::size_t(L.bs), 0.0);  // sizes only
                 if (!coarse.factor(*Al)) throw Error("AMG: the coarsest level's factorisation failed (a zero pivot)");
@@ -815,11 +816,9 @@ struct SmoothedAggregation::Impl {
             tentative_blocks(B, L.bs, Members(L.agg, count), l == 0 ? free.data() : nullptr, Qn, Bc);
             const double f = settings.prolongator_weight / rho;  // w / rho (w = 4/3 by default)
             const bool covered = L.bs == 3 ? smooth_into<3>(*Al, D, Qn, L.agg, f, P) : smooth_into<6>(*Al, D, Qn, L.agg, f, P);
-            if (grow) {  // build()'s, for the accessors (release_build_data() frees them)
+            if (grow) {
                 P.drop_zero_blocks();
                 L.P_tent = tentative_matrix(Qn, L.agg, L.bs, count);
-                L.B = B;
-                level[l + 1].B = Bc;
             }
             L.P = std::move(P);
             hold(L);
