@@ -81,7 +81,7 @@ AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
 bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
 int g_threads = 1;                          // --threads N: the step part on the pool back-end's N threads
 std::vector<double> g_youngs;  // --youngs: Young's moduli to step each mesh at (empty: the scene's own)
-bool g_trace = false;                       // --trace: the run part prints auto's iterations and refreshes per step
+bool g_trace = false;                       // --trace: the run part prints each preconditioner's iterations (and refreshes) per step
 bool g_amg_only = false;                    // --amg-only: the matrix part without block-Jacobi (large meshes)
 
 std::string describe(const AmgSettings& a) {
@@ -327,18 +327,26 @@ void bench_runs(const std::vector<std::string>& meshes, const std::vector<double
                         sim.back()->step();
                     }
                     double ms[3] = {0, 0, 0}, its[3] = {0, 0, 0}, refreshes[3] = {0, 0, 0};
-                    for (int r = 0; r < steps; ++r)
+                    for (int r = 0; r < steps; ++r) {
+                        int step_its[3], step_refreshes[3];
+                        double step_ms[3];
                         for (int k = 0; k < 3; ++k) {
                             const auto t0 = Clock::now();
                             const StepStats& st = sim[std::size_t(k)]->step();
-                            ms[k] += ms_since(t0) / steps;
+                            step_ms[k] = ms_since(t0);
+                            ms[k] += step_ms[k] / steps;
                             its[k] += double(st.solver_iterations) / steps;
                             refreshes[k] += st.preconditioner_refreshes;
-                            if (g_trace && k == 2)
-                                std::fprintf(stderr, "%s Y %g dt %g step %d: auto %d its, %d refreshes\n", m.c_str(),
-                                             s.materials.fallback.young, dt, r + 2, st.solver_iterations,
-                                             st.preconditioner_refreshes);
+                            step_its[k] = st.solver_iterations;
+                            step_refreshes[k] = st.preconditioner_refreshes;
                         }
+                        if (g_trace)
+                            std::fprintf(stderr, "%s Y %g dt %g step %d: BJ %d its %.2f ms, AMG %d its %d refreshes %.2f ms, auto %d its %d "
+                                         "refreshes %.2f ms\n",
+                                         m.c_str(), s.materials.fallback.young, dt, r + 2, step_its[0], step_ms[0],
+                                         step_its[1], step_refreshes[1], step_ms[1], step_its[2], step_refreshes[2],
+                                         step_ms[2]);
+                    }
                     std::printf("| %s | %g | %g | %.1f | %.1f | %.1f | %.0f | %.0f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
                                 m.c_str(), s.materials.fallback.young, dt, its[0], its[1], its[2], refreshes[1],
                                 refreshes[2], ms[0], ms[1], ms[2], ms[1] / ms[0], ms[2] / ms[0],

@@ -63,7 +63,7 @@ public:
         // Built again (on the positions now) where a refresh no longer brings
         // the iterations back to those after the build: the body has moved or
         // deformed far from where the prolongators were made.
-        refresh(A, c, !built_ || (built_rate_ > 0 && fresh_rate_ > kRebuild * built_rate_));
+        refresh(A, c, !built_ || rebuild_ || (built_rate_ > 0 && fresh_rate_ > kRebuild * built_rate_));
     }
 
     bool indefinite() const override { return amg_.coarsest_indefinite(); }
@@ -111,10 +111,12 @@ public:
         }
     }
 
-    // Refreshed at the next set-up (built again there if that refresh then
-    // falls short of the build's iterations: the body may have moved on
-    // while block-Jacobi served, "auto").
-    void invalidate() override { stale_ = true; }
+    // Built again at the next set-up, on the positions there: the body has
+    // moved on while block-Jacobi served ("auto"), and a refresh alone would
+    // keep rigid-body modes and aggregates of where it was (a soft beam
+    // folding at 33 ms steps: 23-29 iterations per step after such a
+    // refresh, 15-16 rebuilt; a rebuild costs about 1.2 refreshes).
+    void invalidate() override { stale_ = rebuild_ = true; }
 
     // The hierarchy and the last refresh are rebuilt from the points they
     // were made at (the matrices would take ~100x the space).
@@ -130,6 +132,7 @@ public:
         w.value(skip_);
         w.value(built_rate_);
         w.value(builds_);
+        w.value(rebuild_);
         built_at_.save(w);
         rebuilt_at_.save(w);
         refreshed_at_.save(w);
@@ -147,6 +150,7 @@ public:
         skip_ = r.value<bool>("AMG skip flag");
         built_rate_ = r.value<double>("AMG iterations per decade after the build");
         builds_ = r.value<int>("AMG builds");
+        rebuild_ = r.value<bool>("AMG rebuild flag");
         built_at_.load(r, s_.n());
         rebuilt_at_.load(r, s_.n());
         refreshed_at_.load(r, s_.n());
@@ -216,7 +220,7 @@ private:
         built_ = true;
         c_ = c;
         age_ = 0;
-        stale_ = false;
+        stale_ = rebuild_ = false;
         measure_ = true;
     }
 
@@ -241,6 +245,7 @@ private:
     std::array<double, 3> c_{};  // c_m, c_k, c_b at the last refresh
     int age_ = 0;                // set-ups since the last refresh
     bool stale_ = false;         // the iterations grew: refresh at the next K
+    bool rebuild_ = false;       // invalidated: build again at the next K
     // CG's iterations (per decade, and of the solve) right after the last
     // refresh that was followed by a whole solve (-1 and 0: none yet).
     double fresh_rate_ = -1;

@@ -26,6 +26,20 @@
 // margin): a block-Jacobi solve that stays under it was the cheaper one, one
 // that goes past it changes to AMG again (refreshed first if block-Jacobi
 // served more than one set-up), which then has the higher bound to beat.
+// That bound comes from solves that may have been the body's early
+// transient, when the lagged AMG refreshes at every step (a soft beam
+// folding under long steps: 500-800 units per solve in its first 15 steps,
+// 250 after, against block-Jacobi's 360). So after kHold block-Jacobi
+// set-ups the threshold goes back to the first one, and AMG is tried again
+// if its last stint was a transient, its cost per solve at least
+// kTransient x its cheapest solve's (refreshes, stale solves: a K that
+// changed fast), and that cheapest solve cost less than block-Jacobi's
+// last. Where the AMG's cost was steady and still dearer (bunny-50k at
+// 1e4 Pa and 4 ms: 8-13 iterations per solve, no refresh, 1.0-1.6x
+// block-Jacobi's 90), or where even its cheapest solve was dearer (few
+// block-Jacobi iterations), no trial is paid. Each going back
+// doubles the wait, so where the trials fail they cost a few per cent of a
+// run, at most log2(steps / kHold) of them.
 // Counts and residuals are the same for any thread count, so is every switch
 // and the run. Never AMG with a fixed CG budget (cg_fixed_iterations: a
 // haptic loop's iteration costs must stay block-Jacobi's) or off the host
@@ -33,6 +47,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "solvers/preconditioner.hpp"
 
@@ -45,6 +60,8 @@ constexpr double kBuild = 420;        // and per rebuild of its hierarchy (Smoot
                                       // 1.13-1.36 refreshes; the first, whole build, 1.7-1.8, is paid at the switch)
 constexpr int kWindow = 8;            // AMG solves its cost is judged over
 constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
+constexpr int kHold = 8;              // block-Jacobi set-ups after the first going back before AMG may be tried again
+constexpr double kTransient = 1.5;    // a stint's cost per solve over its cheapest one's that may be a transient
 
 template <class S>
 class AutoPreconditioner final : public Preconditioner<S> {
@@ -61,7 +78,12 @@ public:
             active_ = bj_.get();
             bj_setups_ = 0;
         }
-        if (!on_amg()) ++bj_setups_;
+        if (!on_amg()) {
+            ++bj_setups_;
+            // The wait after a going back is over: AMG may be tried again
+            // (the next solve past the first threshold) if it could win.
+            if (wait_ > 0 && --wait_ == 0 && bj_rate_ > floor_) threshold_ = s_.scene.solver.auto_amg_iterations;
+        }
         active_->setup(A);
     }
 
@@ -71,12 +93,15 @@ public:
         if (on_amg()) return amg_->switch_now(A, residual);  // its refresh part way
         switch_decades_ = residual_decades(residual, 0.05);
         if (!amg_) amg_ = make_amg(s_);
-        else if (bj_setups_ > 1) amg_->invalidate();  // its operators are those of an older K
+        else if (bj_setups_ > 1) amg_->invalidate();  // its hierarchy is that of an older K and body
         active_ = amg_.get();
         active_->setup(A);
         seen_ = amg_->refreshes();
         seen_builds_ = amg_->rebuilds();
         count_ = 0;
+        floor_ = std::numeric_limits<double>::infinity();
+        stint_cost_ = stint_decades_ = 0;
+        wait_ = 0;
         just_switched_ = true;
     }
 
@@ -98,15 +123,21 @@ public:
             // count). Of this solve's AMG part, its set-up is paid, and the
             // AMG is not told it: it started from block-Jacobi's iterate, so
             // its few iterations are no rate for the lagged AMG's staleness
-            // test to compare later solves with.
+            // test to compare later solves with. Block-Jacobi's last whole
+            // solve (one before a trial after a going back) is a rate known,
+            // not extrapolated: at least that.
             just_switched_ = false;
-            bj_rate_ = std::clamp(threshold_ * d / switch_decades_, double(threshold_), 3.0 * threshold_) / d;
+            bj_rate_ = std::max(bj_rate_,
+                                std::clamp(threshold_ * d / switch_decades_, double(threshold_), 3.0 * threshold_) / d);
             return;
         }
         amg_->solved(iterations, residual);
         const double per_iteration = amg_->iteration_cost() / bj_->iteration_cost();
-        window_[std::size_t(count_ % kWindow)] = {
-            iterations * per_iteration + (refreshed - built) * kRefresh + built * kBuild, d};
+        const double solve_cost = iterations * per_iteration + (refreshed - built) * kRefresh + built * kBuild;
+        floor_ = std::min(floor_, solve_cost / d);
+        stint_cost_ += solve_cost;
+        stint_decades_ += d;
+        window_[std::size_t(count_ % kWindow)] = {solve_cost, d};
         ++count_;
         // Over the last kWindow solves; before there are that many, as soon
         // as the ones so far cost more than block-Jacobi's rate would over
@@ -122,6 +153,9 @@ public:
         const double per_solve = kMargin * cost / n;
         const int cap = s_.scene.solver.cg_max_iterations * 4 / 5;
         threshold_ = std::max(s_.scene.solver.auto_amg_iterations, int(std::min<double>(cap, std::ceil(per_solve))));
+        hold_ = hold_ == 0 ? kHold : 2 * hold_;
+        wait_ = hold_;
+        if (stint_cost_ < kTransient * floor_ * stint_decades_) floor_ = std::numeric_limits<double>::infinity();
     }
 
     void save(CheckpointWriter& w) const override {
@@ -135,6 +169,11 @@ public:
         w.value(seen_builds_);
         w.value(count_);
         w.value(bj_setups_);
+        w.value(hold_);
+        w.value(wait_);
+        w.value(floor_);
+        w.value(stint_cost_);
+        w.value(stint_decades_);
         for (const auto& [c, e] : window_) {
             w.value(c);
             w.value(e);
@@ -157,6 +196,12 @@ public:
         count_ = r.value<int>("auto preconditioner: AMG solves");
         if (count_ < 0) r.fail("auto preconditioner", "negative AMG solve count");
         bj_setups_ = r.value<int>("auto preconditioner: block-Jacobi set-ups");
+        hold_ = r.value<int>("auto preconditioner: hold");
+        wait_ = r.value<int>("auto preconditioner: wait");
+        if (hold_ < 0 || wait_ < 0 || wait_ > hold_) r.fail("auto preconditioner", "hold or wait out of range");
+        floor_ = r.value<double>("auto preconditioner: AMG floor");
+        stint_cost_ = r.value<double>("auto preconditioner: AMG stint cost");
+        stint_decades_ = r.value<double>("auto preconditioner: AMG stint decades");
         for (auto& [c, e] : window_) {
             c = r.value<double>("auto preconditioner: AMG cost");
             e = r.value<double>("auto preconditioner: AMG decades");
@@ -192,6 +237,11 @@ private:
     int seen_ = 0, seen_builds_ = 0;  // the AMG's refreshes and builds counted so far
     int count_ = 0;              // AMG solves since it took over (but the first)
     int bj_setups_ = 0;          // set-ups block-Jacobi served since it took over
+    int hold_ = 0;               // block-Jacobi set-ups after the last going back before AMG may be tried again
+    int wait_ = 0;               // of those, the ones still to come
+    double floor_ = std::numeric_limits<double>::infinity();  // the AMG's cheapest solve since the switch, per
+                                                              // decade (infinite after a steady stint: no trial)
+    double stint_cost_ = 0, stint_decades_ = 0;  // the AMG's cost and decades since the switch (but its first solve)
     std::array<std::array<double, 2>, kWindow> window_{};  // the last ones' cost and decades
 };
 

@@ -43,8 +43,9 @@ public:
     // matrix (a count, the same on any machine: the auto preconditioner's
     // cost model): block-Jacobi 1, AMG 1 + its V-cycle.
     virtual double iteration_cost() const { return 1; }
-    // Makes its next set-up recompute its operators (a lagged one: as if
-    // its last solve had found them stale).
+    // Makes its next set-up recompute its operators, as for a K far from
+    // the last one (the AMG builds its hierarchy again, on the positions
+    // there).
     virtual void invalidate() {}
     // A preconditioner that gives way to a stronger one part way through a
     // solve ("auto"; the lagged AMG's refresh part way): the CG iterations
