@@ -21,11 +21,14 @@
 // block-Jacobi. Block-Jacobi's cost is known from its last whole solve; of
 // the solve it gave up, only its rate up to the threshold (the iterations
 // extrapolated to the solve's decades, kept within 1-3x the threshold). When the AMG's
-// cost over its last kWindow solves exceeds that, the next set-up goes back
-// to block-Jacobi, whose threshold becomes the AMG's cost per solve (with a
+// cost over its last kWindow solves exceeds that (or, before there are
+// that many, over its first two or more solves kMargin x that: a trial that
+// costs a fifth of a short run is no trial), the next set-up goes back to
+// block-Jacobi, whose threshold becomes the AMG's cost per solve (with a
 // margin): a block-Jacobi solve that stays under it was the cheaper one, one
-// that goes past it changes to AMG again (refreshed first if block-Jacobi
-// served more than one set-up), which then has the higher bound to beat.
+// that goes past it changes to AMG again (built again on the body as it is
+// if block-Jacobi served more than one set-up), which then has the higher
+// bound to beat.
 // That bound comes from solves that may have been the body's early
 // transient, when the lagged AMG refreshes at every step (a soft beam
 // folding under long steps: 500-800 units per solve in its first 15 steps,
@@ -141,14 +144,17 @@ public:
         ++count_;
         // Over the last kWindow solves; before there are that many, as soon
         // as the ones so far cost more than block-Jacobi's rate would over
-        // the whole window (the rest counted at this solve's decades, free).
+        // the whole window (the rest counted at this solve's decades, free),
+        // or, from two on, kMargin x more than it would over them.
         const int n = std::min(count_, kWindow);
-        double cost = 0, dec = (kWindow - n) * d;
+        double cost = 0, seen = 0;
         for (int i = 0; i < n; ++i) {
             cost += window_[std::size_t(i)][0];
-            dec += window_[std::size_t(i)][1];
+            seen += window_[std::size_t(i)][1];
         }
-        if (cost <= bj_rate_ * dec) return;
+        const bool dear = cost > bj_rate_ * (seen + (kWindow - n) * d) ||
+                          (n >= 2 && n < kWindow && cost > kMargin * bj_rate_ * seen);
+        if (!dear) return;
         back_ = true;
         const double per_solve = kMargin * cost / n;
         const int cap = s_.scene.solver.cg_max_iterations * 4 / 5;
