@@ -22,8 +22,8 @@
 // the solve it gave up, only its rate up to the threshold (the iterations
 // extrapolated to the solve's decades, kept within 1-3x the threshold). When the AMG's
 // cost over its last kWindow solves exceeds that (or, before there are
-// that many, over its first two or more solves kMargin x that: a trial that
-// costs a fifth of a short run is no trial), the next set-up goes back to
+// that many, as soon as two or more cost kMargin x that: a trial should
+// cost a few solves, not a window's), the next set-up goes back to
 // block-Jacobi, whose threshold becomes the AMG's cost per solve (with a
 // margin): a block-Jacobi solve that stays under it was the cheaper one, one
 // that goes past it changes to AMG again (built again on the body as it is
@@ -208,6 +208,9 @@ public:
         floor_ = r.value<double>("auto preconditioner: AMG floor");
         stint_cost_ = r.value<double>("auto preconditioner: AMG stint cost");
         stint_decades_ = r.value<double>("auto preconditioner: AMG stint decades");
+        if (!(floor_ >= 0) || !(stint_cost_ >= 0) || !(stint_decades_ >= 0) || std::isinf(stint_cost_) ||
+            std::isinf(stint_decades_))
+            r.fail("auto preconditioner", "AMG floor or stint out of range");
         for (auto& [c, e] : window_) {
             c = r.value<double>("auto preconditioner: AMG cost");
             e = r.value<double>("auto preconditioner: AMG decades");
