@@ -66,7 +66,9 @@ struct SolverSettings {
     // Auto: the block-Jacobi CG iterations of one solve past which AMG takes
     // over (docs/solvers.md has the measured crossover), at first; where AMG
     // then costs more, block-Jacobi comes back with the AMG's cost as its
-    // threshold. Never with cg_fixed_iterations, or off the host.
+    // threshold (this one again after a wait of 8, 16, 32, ... set-ups where
+    // the AMG's dear solves looked like a transient). Never with
+    // cg_fixed_iterations, or off the host.
     int auto_amg_iterations = 60;
     // AMG: when its Galerkin operators and smoothers follow a new K (the
     // fine level's products are always the current K's). 0 (default): lagged
