@@ -21,7 +21,7 @@
 //                         [--amg-levels N] [--amg-ratio R] [--amg-weight W] [--amg-strength S] [--no-hypre] [--quick]
 //                         [--threads N]  (the step part on the pool back-end's N threads; default serial)
 //                         [--amg-only]   (the matrix part without block-Jacobi: the largest meshes)
-//                         [--trace]      (the run part: auto's iterations and refreshes per step, on stderr)
+//                         [--trace]      (the run part: each preconditioner's iterations, refreshes and ms per step, on stderr)
 // (--amg-*: AmgSettings' fields, for the step and matrix parts, to study the
 // hierarchy; unset ones keep SolverSettings' defaults)
 #include <HYPRE.h>
@@ -81,7 +81,7 @@ AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
 bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
 int g_threads = 1;                          // --threads N: the step part on the pool back-end's N threads
 std::vector<double> g_youngs;  // --youngs: Young's moduli to step each mesh at (empty: the scene's own)
-bool g_trace = false;                       // --trace: the run part prints each preconditioner's iterations (and refreshes) per step
+bool g_trace = false;                       // --trace: the run part prints each preconditioner's iterations, refreshes and ms per step
 bool g_amg_only = false;                    // --amg-only: the matrix part without block-Jacobi (large meshes)
 
 std::string describe(const AmgSettings& a) {
