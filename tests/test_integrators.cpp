@@ -240,12 +240,60 @@ TEST(Integrators, EnergyGuardCatchesTrapezoidalBlowUp) {
     }
     std::printf("newmark: %s\n", message.c_str());
     EXPECT_NE(message.find("energy grew without a source"), std::string::npos) << message;
+    // The advice is the trapezoidal rule's remedy: numerical damping.
+    EXPECT_NE(message.find("use bdf2 or generalized-alpha"), std::string::npos) << message;
+    EXPECT_EQ(message.find("use an implicit integrator"), std::string::npos) << message;
     for (Integrator integ : {Integrator::Bdf2, Integrator::Bdf2Linear}) {
         SCOPED_TRACE(to_string(integ));
         Simulator<double> sim(twisted(integ));
         twist(sim);
         EXPECT_NO_THROW(for (int k = 0; k < 200; ++k) sim.step());
     }
+}
+
+// The stress suite's nearly incompressible bar (6x2x2 cm, Y = 1e5 Pa, nu =
+// 0.499, alpha = 10 /s, released from a bend, dt = 1 ms, the guard at 2, 3
+// step halvings):
+// generalized-alpha by Newton at the default rho_inf 0.8 is unstable there
+// and the guard stops it, naming the remedy; at rho_inf 0.5, the remedy,
+// it runs to rest (bench/rho_inf_study.py,
+// docs/lab/2026-11-28-rho-inf-incompressible.md).
+TEST(Integrators, GeneralizedAlphaOnANearlyIncompressibleBarNamesItsRemedy) {
+    auto bar = [](double rho_inf) {
+        Scene s = test::clamped_box_scene(6, 2, 2, 1e5);
+        s.materials = Material{1e5, 0.499, 1000};
+        s.gravity = {0, 0, 0};
+        s.rayleigh_alpha = 10;
+        s.integrator = Integrator::GeneralizedAlpha;
+        s.integrator_parameters.rho_inf = rho_inf;
+        s.dt = 1e-3;
+        s.solver.max_energy_growth = 2;
+        s.solver.max_step_halvings = 3;
+        auto sim = std::make_unique<Simulator<double>>(std::move(s));
+        const Mesh& m = sim->scene().mesh;
+        double x0 = 1e300, x1 = -1e300;
+        for (index_t v = 0; v < m.num_vertices(); ++v) x0 = std::min(x0, m.X[3 * v]), x1 = std::max(x1, m.X[3 * v]);
+        auto u = sim->displacement();
+        for (index_t v = 0; v < m.num_vertices(); ++v) {
+            const double t = (m.X[3 * v] - x0) / (x1 - x0);
+            u[3 * v + 2] = 0.2 * (x1 - x0) * t * t;
+        }
+        return sim;
+    };
+    std::string message;
+    try {
+        auto sim = bar(0.8);
+        for (int k = 0; k < 500; ++k) sim->step();
+    } catch (const SimulationError& e) {
+        message = e.what();
+    }
+    EXPECT_NE(message.find("energy grew without a source"), std::string::npos) << message;
+    EXPECT_NE(message.find("lower generalized_alpha.rho_inf"), std::string::npos) << message;
+    auto sim = bar(0.5);
+    double umax = 0;
+    ASSERT_NO_THROW(for (int k = 0; k < 2000; ++k) sim->step());
+    for (double x : sim->displacement()) umax = std::max(umax, std::abs(x));
+    EXPECT_LT(umax, 1e-5 * 0.06) << "at rest within 1e-5 of the bar's length after 2 s";
 }
 
 // The energy guard's account of mass damping (TimeIntegrator::

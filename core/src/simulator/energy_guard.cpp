@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "simulator/instability_advice.hpp"
 #include "simulator/messages.hpp"
 
 namespace edgefem::sim {
@@ -142,8 +143,7 @@ void EnergyGuard<S>::check(double T, const EnergySample& start, const S* u0, con
                                                    " J net of the external work since its lowest level; largest " +
                                                    sci(scale) + " J)") +
                                   ", over solver.max_energy_growth = " + lim + "; fastest vertex " +
-                                  std::to_string(vertex) +
-                                  " (unstable: reduce dt, use an implicit integrator or improve the mesh's worst tets)",
+                                  std::to_string(vertex) + " (" + instability_advice(scene.integrator) + ")",
                               vertex};
         }
         excess = std::max(0.0, excess);

@@ -6,6 +6,7 @@
 #include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/surface_load.hpp"
 #include "simulator/checkpoint_stream.hpp"
+#include "simulator/instability_advice.hpp"
 #include "simulator/timing.hpp"
 
 namespace edgefem::sim {
@@ -241,7 +242,7 @@ void SimState<S>::check_finite(long step_no) const {
         const bool u_finite = std::isfinite(double(u.read_host(scratch)[i]));
         throw StepFailure{"step " + std::to_string(step_no) + ": non-finite " +
                               (u_finite ? "velocity" : "displacement") + " at vertex " + std::to_string(i / 3) +
-                              " (unstable: reduce dt or use an implicit integrator)",
+                              " (" + instability_advice(scene.integrator) + ")",
                           index_t(i / 3)};
     }
 }
