@@ -27,12 +27,13 @@
 // The stiff ones (slender to shake-rubber) are where the explicit stable
 // step is far below the step the motion needs: a fine, thin or nearly
 // incompressible body, whose fastest (pressure) wave crosses a cell in
-// microseconds, moved slowly or bending in a few Hz. They separate three cases: released at once
-// (slender), the second bending mode swings with a few % of the amplitude
-// and a step too long for it cannot follow; driven slowly (press), the
-// motion is nearly static and first-order backward Euler at a long step is
-// as accurate as anything; shaken and then free (shake), the first mode
-// swings undamped: the case the implicit second-order integrators are for.
+// microseconds, moved slowly or bending in a few Hz. They separate three
+// cases: released at once (slender), the second bending mode swings with a
+// few % of the amplitude and a step too long for it cannot follow; driven
+// slowly (press), the motion is nearly static and first-order backward
+// Euler at a long step is as accurate as anything; shaken and then free
+// (shake), the first mode swings undamped: the case the implicit
+// second-order integrators are for.
 //
 // Each scene has a reference trajectory: the trapezoidal rule (Newmark beta
 // = 1/4, gamma = 1/2, second order) solved by Newton (relative tolerance
