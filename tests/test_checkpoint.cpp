@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <numeric>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -383,6 +384,33 @@ TEST(Checkpoint, LaggedAmgRebuiltBeforeTheCheckpoint) {
     Simulator<double> resumed(s);
     resumed.load_checkpoint(path);
     for (int k = 0; k < half; ++k) resumed.step();
+    expect_same(state_of(straight), state_of(resumed), "resumed");
+}
+
+// auto's state across a checkpoint written while block-Jacobi waits out
+// its hold after going back (the soft box of
+// Solvers.AutoPreconditionerGoesBackWhereAmgRefreshesEveryStep: AMG in
+// steps 1-6, block-Jacobi from step 7, the AMG tried again from step 14):
+// the resumed run tries it again in the same step, with the same bits.
+TEST(Checkpoint, AutoPreconditionerWaitingToTryTheAmgAgain) {
+    Scene s = test::clamped_box_scene(24, 6, 6, 1e4);
+    s.dt = 33e-3;
+    s.solver.cg_max_iterations = 5000;
+    test::TempDir dir("ckpt_auto_wait");
+    const std::string path = dir.file("waiting.ckpt");
+    const int before = 10, after = 10;
+    Simulator<double> straight(s), first(s);
+    std::vector<int> straight_refreshes;
+    for (int k = 0; k < before + after; ++k) straight_refreshes.push_back(straight.step().preconditioner_refreshes);
+    for (int k = 0; k < before; ++k) first.step();
+    first.save_checkpoint(path);
+    Simulator<double> resumed(s);
+    resumed.load_checkpoint(path);
+    std::vector<int> resumed_refreshes;
+    for (int k = 0; k < after; ++k) resumed_refreshes.push_back(resumed.step().preconditioner_refreshes);
+    ASSERT_GT(std::accumulate(straight_refreshes.begin() + before, straight_refreshes.end(), 0), 0)
+        << "the AMG tried again after the checkpoint";
+    EXPECT_EQ(std::vector<int>(straight_refreshes.begin() + before, straight_refreshes.end()), resumed_refreshes);
     expect_same(state_of(straight), state_of(resumed), "resumed");
 }
 
