@@ -24,9 +24,14 @@
 //                         [--trace]      (the run part: each preconditioner's iterations, refreshes and ms per step, on stderr)
 // (--amg-*: AmgSettings' fields, for the step and matrix parts, to study the
 // hierarchy; unset ones keep SolverSettings' defaults)
+#ifndef EDGEFEM_BENCH_HYPRE
+#define EDGEFEM_BENCH_HYPRE 0
+#endif
+#if EDGEFEM_BENCH_HYPRE
 #include <HYPRE.h>
 #include <HYPRE_parcsr_ls.h>
 #include <mpi.h>
+#endif
 
 #include <dlfcn.h>
 
@@ -78,7 +83,7 @@ double median(std::vector<double> v) {
 }
 
 AmgSettings g_amg = SolverSettings{}.amg;  // the AMG's settings (--amg-*)
-bool g_no_hypre = false;                    // --no-hypre: the matrix part without BoomerAMG
+bool g_no_hypre = !EDGEFEM_BENCH_HYPRE;     // --no-hypre: the matrix part without BoomerAMG
 int g_threads = 1;                          // --threads N: the step part on the pool back-end's N threads
 std::vector<double> g_youngs;  // --youngs: Young's moduli to step each mesh at (empty: the scene's own)
 bool g_trace = false;                       // --trace: the run part prints each preconditioner's iterations, refreshes and ms per step
@@ -175,8 +180,14 @@ std::string blas_library() {
     Dl_info info{};
     if (dgemm == nullptr || dladdr(dgemm, &info) == 0 || info.dli_fname == nullptr) return "unknown";
     char* real = realpath(info.dli_fname, nullptr);  // through the alternatives' links
-    const std::string path = real != nullptr ? real : info.dli_fname;
+    std::string path = real != nullptr ? real : info.dli_fname;
     std::free(real);
+    // OpenBLAS's kernels: on a CPU it does not recognise (a VM's plain
+    // "Intel Xeon Processor") it falls back to slow generic ones, 3x here
+    // (docs/solvers.md, "Direct solver"); OPENBLAS_CORETYPE overrides.
+    using CoreName = char* (*)();
+    if (auto core = reinterpret_cast<CoreName>(dlsym(RTLD_DEFAULT, "openblas_get_corename")))
+        path += std::string(" (OpenBLAS kernels: ") + core() + ")";
     return path;
 }
 
@@ -388,6 +399,7 @@ struct HypreResult {
     double setup_ms = 0, solve_ms = 0, residual = 0;
 };
 
+#if EDGEFEM_BENCH_HYPRE
 // hypre BoomerAMG-preconditioned PCG on A (free dofs), systems AMG with 3
 // functions (unknown approach) and nodal coarsening.
 HypreResult hypre_solve(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const Eigen::VectorXd& b,
@@ -466,6 +478,12 @@ HypreResult hypre_solve(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, c
     HYPRE_IJMatrixDestroy(ij);
     return res;
 }
+#else
+// Built without hypre (EDGEFEM_BENCH_HYPRE=OFF): g_no_hypre is always set.
+HypreResult hypre_solve(const Eigen::SparseMatrix<double, Eigen::RowMajor>&, const Eigen::VectorXd&, Eigen::VectorXd&) {
+    std::abort();
+}
+#endif
 
 void bench_matrix(const std::vector<std::string>& meshes, const std::vector<double>& dts, int rounds) {
     std::printf("\n## matrix: one assembled A = M + dt^2 K (after 3 steps), PCG from 0 to 1e-6, serial; medians of %d\n\n",
@@ -671,11 +689,15 @@ int main(int argc, char** argv) {
     if (parts.find("step") != std::string::npos) bench_steps(meshes, dts, rounds);
     if (parts.find("run") != std::string::npos) bench_runs(meshes, dts, rounds);
     if (parts.find("matrix") != std::string::npos) {
+#if EDGEFEM_BENCH_HYPRE
         // MPI (hypre's) only here: its singleton start leaves a helper process running.
         MPI_Init(&argc, &argv);
         bench_matrix(meshes, dts, rounds);
         HYPRE_Finalize();
         MPI_Finalize();
+#else
+        bench_matrix(meshes, dts, rounds);
+#endif
     }
     return 0;
 }
