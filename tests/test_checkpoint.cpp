@@ -414,5 +414,33 @@ TEST(Checkpoint, AutoPreconditionerWaitingToTryTheAmgAgain) {
     expect_same(state_of(straight), state_of(resumed), "resumed");
 }
 
+// A run checkpointed while it remembers a step halving (the nearly
+// incompressible bar under the linearised generalized-alpha: its first
+// halving, then 4 steps into the hold) goes on halved after a restart, with
+// the same bits as the straight run; it fails if the halving state is not
+// restored (the resumed run starts with whole steps).
+TEST(Checkpoint, RememberedStepHalving) {
+    const Scene s = test::bent_incompressible_bar(Integrator::GeneralizedAlphaLinear, 0.8, 3);
+    test::TempDir dir("ckpt_halving");
+    const std::string path = dir.file("halved.ckpt");
+    Simulator<double> straight(s), first(s);
+    int before = 0;
+    while (first.step().halvings == 0) ASSERT_LT(++before, 1000) << "no halving";
+    for (int k = 0; k < 4; ++k) ASSERT_EQ(first.step().halvings, 0);
+    before += 5;
+    first.save_checkpoint(path);
+    for (int k = 0; k < before; ++k) straight.step();
+    Simulator<double> resumed(s);
+    resumed.load_checkpoint(path);
+    std::vector<int> straight_depths, resumed_depths;
+    for (int k = 0; k < 40; ++k) {
+        straight_depths.push_back(straight.step().substep_depth);
+        resumed_depths.push_back(resumed.step().substep_depth);
+    }
+    EXPECT_GT(straight_depths.front(), 0) << "halved after the checkpoint";
+    EXPECT_EQ(straight_depths, resumed_depths);
+    expect_same(state_of(straight), state_of(resumed), "resumed");
+}
+
 }  // namespace
 }  // namespace edgefem

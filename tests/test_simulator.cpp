@@ -306,6 +306,9 @@ TEST(Simulator, FloatTracksDoubleAndSceneErrorsNameTheField) {
     s.solver.cg_tolerance = 0;
     expect_field(s, "solver.cg_tolerance");
     s = cantilever(Integrator::SemiImplicit, 1e-3);
+    s.solver.max_step_halvings = 31;  // a step in 2^31 pieces
+    expect_field(s, "solver.max_step_halvings");
+    s = cantilever(Integrator::SemiImplicit, 1e-3);
     s.method = Method::Tet;
     s.model = ModelKind::SN;
     expect_field(s, "model");

@@ -172,7 +172,8 @@ void Scene::validate() const {
     positive("solver.newton_tolerance", solver.newton_tolerance);
     if (solver.newton_max_iterations < 1) bad("solver.newton_max_iterations", "must be >= 1");
     if (solver.load_steps < 1) bad("solver.load_steps", "must be >= 1");
-    if (solver.max_step_halvings < 0) bad("solver.max_step_halvings", "must be >= 0");
+    if (solver.max_step_halvings < 0 || solver.max_step_halvings > 30)
+        bad("solver.max_step_halvings", "must be in [0, 30]");
     if (solver.stiffness_interval < 1) bad("solver.stiffness_interval", "must be >= 1");
     // Settings that only the linearised steps with CG read: elsewhere they
     // were accepted and silently ignored.

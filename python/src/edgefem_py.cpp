@@ -581,6 +581,7 @@ PYBIND11_MODULE(_edgefem, m) {
         .def_readonly("negative_curvature", &StepStats::negative_curvature)
         .def_readonly("inverted_tets", &StepStats::inverted_tets)
         .def_readonly("halvings", &StepStats::halvings)
+        .def_readonly("substep_depth", &StepStats::substep_depth)
         .def_readonly("unconverged_solves", &StepStats::unconverged_solves)
         .def_readonly("newton_round_off", &StepStats::newton_round_off)
         .def_readonly("energy_growth", &StepStats::energy_growth)

@@ -24,6 +24,31 @@ inline Scene clamped_box_scene(int nx, int ny, int nz, double young = 2e4) {
     return s;
 }
 
+// The stress suite's nearly incompressible bar: 6 x 2 x 2 cubes, Y = 1e5 Pa,
+// nu = 0.499, alpha = 10 /s, no gravity, released from the bend u_z = 0.2 L
+// s^2 (s = x / L), dt = 1 ms, the energy guard at 2, `halvings` step
+// halvings; rho_inf for generalized-alpha.
+inline Scene bent_incompressible_bar(Integrator integrator, double rho_inf, int halvings) {
+    Scene s = clamped_box_scene(6, 2, 2, 1e5);
+    s.materials = Material{1e5, 0.499, 1000};
+    s.gravity = {0, 0, 0};
+    s.rayleigh_alpha = 10;
+    s.integrator = integrator;
+    s.integrator_parameters.rho_inf = rho_inf;
+    s.dt = 1e-3;
+    s.solver.max_energy_growth = 2;
+    s.solver.max_step_halvings = halvings;
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0;
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+        x0 = std::min(x0, s.mesh.X[3 * v]), x1 = std::max(x1, s.mesh.X[3 * v]);
+    s.initial_displacement.assign(s.mesh.X.size(), 0.0);
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v) {
+        const double t = (s.mesh.X[3 * v] - x0) / (x1 - x0);
+        s.initial_displacement[3 * std::size_t(v) + 2] = 0.2 * (x1 - x0) * t * t;
+    }
+    return s;
+}
+
 // 8 x 2 x 2 cubes, Y = 2e4 Pa, CG to 1e-10.
 inline Scene cantilever_scene(Integrator integrator = Integrator::SemiImplicit, double dt = 1e-3) {
     Scene s = clamped_box_scene(8, 2, 2);

@@ -1,5 +1,7 @@
 #include "simulator/step_control.hpp"
 
+#include <algorithm>
+#include <cstdint>
 #include <string>
 
 namespace edgefem::sim {
@@ -46,6 +48,7 @@ void StepControl<S>::advance(double T, int depth) {
         s_.copy_state(s_.v, depth == 0 ? step_start_v_ : v_save);
         s_.copy_history(s_.history, depth == 0 ? step_start_history_ : history_save);
         ++s_.stats.halvings;
+        deepest_ = std::max(deepest_, depth + 1);
         advance(T / 2, depth + 1);
         advance(T / 2, depth + 1);
     }
@@ -63,7 +66,10 @@ const StepStats& StepControl<S>::step() {
     s_.copy_state(step_start_v_, s_.v);
     s_.copy_history(step_start_history_, s_.history);
     try {
-        advance(s_.scene.dt, 0);
+        // 2^depth_ pieces (a piece past depth 0 keeps its own start to retry from).
+        deepest_ = depth_;
+        const int pieces = 1 << depth_;
+        for (int k = 0; k < pieces; ++k) advance(s_.scene.dt / pieces, depth_);
     } catch (const StepFailure& failure) {
         s_.time = t_start;
         s_.copy_state(s_.u, step_start_u_);
@@ -73,6 +79,8 @@ const StepStats& StepControl<S>::step() {
         throw SimulationError(failure.message, s_.step + 1, failure.vertex);
     }
     s_.time = t_start + s_.scene.dt;  // no drift from summed halves
+    s_.stats.substep_depth = deepest_;
+    remember(s_.stats.halvings > 0 ? deepest_ : -1);
     ++s_.step;
     if (s_.scene.count_inverted_tets) s_.stats.inverted_tets = s_.op->inverted_tets(s_.u.data());
     if (s_.scene.solver.fail_on_inverted && s_.stats.inverted_tets > 0)
@@ -80,6 +88,50 @@ const StepStats& StepControl<S>::step() {
                                   " inverted tets (negative volume) and solver.fail_on_inverted is set",
                               s_.step);
     return s_.stats;
+}
+
+// After a step: `deepest` the depth its halvings reached, -1 if it needed
+// none.
+template <class S>
+void StepControl<S>::remember(int deepest) {
+    if (deepest >= 0) {
+        const bool repeat = depth_ > 0 || since_up_ < kRepeatWindow;
+        hold_ = repeat ? std::min(4 * hold_, kLongestHold) : kFirstHold;
+        depth_ = deepest;
+        stay_ = hold_;
+        return;
+    }
+    ++since_up_;
+    if (depth_ > 0 && --stay_ <= 0) {
+        --depth_;
+        stay_ = hold_;
+        since_up_ = 0;
+    }
+}
+
+template <class S>
+void StepControl<S>::save(CheckpointWriter& w) const {
+    guard_.save(w);
+    w.value(std::int32_t(depth_));
+    w.value(std::int32_t(stay_));
+    w.value(std::int32_t(hold_));
+    w.value(std::int64_t(since_up_));
+}
+
+template <class S>
+void StepControl<S>::load(CheckpointReader& r) {
+    guard_.load(r);
+    const auto depth = r.value<std::int32_t>("step depth");
+    const auto stay = r.value<std::int32_t>("step hold left");
+    const auto hold = r.value<std::int32_t>("step hold");
+    const auto since_up = r.value<std::int64_t>("steps since a shallower level");
+    if (depth < 0 || depth > s_.scene.solver.max_step_halvings || stay < 0 || stay > kLongestHold ||
+        hold < kFirstHold || hold > kLongestHold || since_up < 0)
+        r.fail("step halving state", "out of range");
+    depth_ = depth;
+    stay_ = stay;
+    hold_ = hold;
+    since_up_ = since_up;
 }
 
 template class StepControl<double>;

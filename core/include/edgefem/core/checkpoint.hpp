@@ -34,7 +34,7 @@ private:
 };
 
 // The format version this build writes and reads.
-inline constexpr std::uint32_t kCheckpointVersion = 5;
+inline constexpr std::uint32_t kCheckpointVersion = 6;
 
 // The 64-bit FNV-1a hash of `bytes` continuing from `hash` (the file's
 // checksum and the mesh hash).

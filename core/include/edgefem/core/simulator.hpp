@@ -45,6 +45,7 @@ struct StepStats {
     int unconverged_solves = 0;  // semi-implicit CG solves that stopped above their tolerance
     index_t inverted_tets = 0;  // at the end of the step
     int halvings = 0;           // step halvings used
+    int substep_depth = 0;      // the step ran as pieces of dt / 2^depth (a halving is remembered: docs/dynamics.md)
     // Energy guard (SolverSettings::max_energy_growth > 0): 1 + the energy
     // gained without a source since its lowest level / the largest kinetic +
     // elastic energy seen, after the step: the ratio the guard bounds.
