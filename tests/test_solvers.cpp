@@ -995,6 +995,39 @@ TEST(Solvers, AutoPreconditionerDoesNotTryAgainAnAmgThatCannotWin) {
     for (int k = first_back; k < steps; ++k) EXPECT_TRUE(on_bj(k)) << "step " << k + 1 << ": " << a.its[std::size_t(k)];
 }
 
+// auto's first AMG solve after its switch has no fresh solve of its own to
+// judge staleness by (the switch solve went on from block-Jacobi's
+// iterate), so a hierarchy already stale (a beam released from a bend: K
+// changes much in one 2 ms step) used to run on: here 386 iterations, and
+// 464 on the same beam of 2.5 mm cells. Past solver.auto_amg_iterations
+// (60) it now refreshes part way and goes on from its iterate, as the
+// lagged AMG does once it has a fresh count (bunny-50k at 1e4 Pa and 33 ms:
+// auto 1.12x -> 0.94x the best, docs/solvers.md).
+TEST(Solvers, AutoPreconditionerRefreshesAStaleFirstAmgSolve) {
+    Scene s;
+    s.mesh = make_box(48, 3, 3, 0.005);
+    s.materials = Material{1e6, 0.45, 1000};
+    s.gravity = {0, 0, 0};
+    s.integrator = Integrator::GeneralizedAlphaLinear;
+    s.dt = 2e-3;
+    s.solver.cg_tolerance = 1e-2;
+    double x0 = 1e300, x1 = -1e300;
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+        x0 = std::min(x0, s.mesh.X[3 * v]), x1 = std::max(x1, s.mesh.X[3 * v]);
+    s.initial_displacement.assign(s.mesh.X.size(), 0.0);
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v) {
+        if (s.mesh.X[3 * v] < x0 + 1e-9) s.fixed.push_back(v);
+        const double t = (s.mesh.X[3 * v] - x0) / (x1 - x0);
+        s.initial_displacement[3 * std::size_t(v) + 2] = 0.04 * t * t;
+    }
+    const StepTrace a = trace_steps(s, PreconditionerKind::Auto, 2);
+    const int threshold = SolverSettings{}.auto_amg_iterations;
+    ASSERT_GT(a.its[0], threshold) << "auto switched in the first solve";
+    ASSERT_EQ(a.refreshes[0], 1);
+    EXPECT_EQ(a.refreshes[1], 1) << "the stale AMG refreshed part way";
+    EXPECT_LE(a.its[1], threshold + 20);
+}
+
 // A lagged AMG whose hierarchy a large change of K made stale refreshes part
 // way through the solve (past 3x + 10 the iterations after its last
 // refresh) instead of running on: the built-in beam at 1e4 Pa and 33 ms
