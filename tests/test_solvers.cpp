@@ -1026,6 +1026,13 @@ TEST(Solvers, AutoPreconditionerRefreshesAStaleFirstAmgSolve) {
     ASSERT_EQ(a.refreshes[0], 1);
     EXPECT_EQ(a.refreshes[1], 1) << "the stale AMG refreshed part way";
     EXPECT_LE(a.its[1], threshold + 20);
+    // A hierarchy made for the A being solved is not refreshed part way,
+    // whatever the count (the AMG alone, its limit set below its first
+    // solve's iterations): it would only make the same operators again.
+    s.solver.auto_amg_iterations = 3;
+    const StepTrace amg = trace_steps(s, PreconditionerKind::Amg, 1);
+    ASSERT_GT(amg.its[0], 3);
+    EXPECT_EQ(amg.refreshes[0], 1) << "the build only";
 }
 
 // A lagged AMG whose hierarchy a large change of K made stale refreshes part

@@ -77,12 +77,14 @@ public:
     // need hundreds of times the iterations (a soft beam folding at 33 ms
     // steps: 728 and 4,022 where a fresh one takes 11). Before a fresh
     // solve has been measured (`auto`'s first AMG solve after its switch,
-    // which continued a block-Jacobi solve), past solver.auto_amg_iterations:
-    // the count at which block-Jacobi is deemed too slow, where a fresh AMG
-    // takes 4-19 (a released beam of 2.5 mm cells at 2 ms: 464 iterations
-    // on the hierarchy of the step before, 42 refreshed).
+    // which continued a block-Jacobi solve) on a hierarchy older than this
+    // set-up, past solver.auto_amg_iterations: the count at which
+    // block-Jacobi is deemed too slow, where a fresh AMG takes 4-19 (a
+    // released beam of 2.5 mm cells at 2 ms: 464 iterations on the
+    // hierarchy of the step before, 42 refreshed). A hierarchy made for
+    // this A is never refreshed part way.
     int switch_after() const override {
-        if (s_.scene.solver.amg_refresh_interval != 0) return 0;
+        if (s_.scene.solver.amg_refresh_interval != 0 || age_ == 0) return 0;
         return fresh_its_ > 0 ? 3 * fresh_its_ + 10 : s_.scene.solver.auto_amg_iterations;
     }
     void switch_now(LinearSystem<S>& A, double /*residual*/) override {
