@@ -182,6 +182,7 @@ void run_simulate(const SimulateOptions& opts) {
     index_t inverted_max = 0;
     long inverted_steps = 0, first_inverted_step = 0;
     long unconverged_steps = 0;  // CG stopped above its tolerance
+    long halved_steps = 0, step_halvings = 0;  // steps run in pieces (solver.max_step_halvings), failed pieces
     Progress progress(opts.quiet ? 0 : steps);
     if (first_step == 0) write_frame();  // a restart's was written by the run before it
     try {
@@ -197,6 +198,8 @@ void run_simulate(const SimulateOptions& opts) {
             inverted_max = std::max(inverted_max, st.inverted_tets);
             if (st.inverted_tets > 0 && inverted_steps++ == 0) first_inverted_step = s;
             unconverged_steps += st.unconverged_solves > 0;
+            halved_steps += st.substep_depth > 0;
+            step_halvings += st.halvings;
             const long step = first_step + s;  // the scene's step number
             if (step % out.every == 0 || s == steps) {
                 write_frame();
@@ -239,6 +242,8 @@ void run_simulate(const SimulateOptions& opts) {
     print_kv("cg_iterations_mean", fmt(steps > 0 ? double(cg_total) / double(steps) : 0.0, 6));
     print_kv("cg_iterations_max", cg_max);
     print_kv("unconverged_steps", unconverged_steps);
+    print_kv("halved_steps", halved_steps);
+    print_kv("step_halvings", step_halvings);
     print_kv("energy_drift", fmt(e_drift, 6));
     print_kv("inverted_tets", inverted_max);
     if (out.vtu)
