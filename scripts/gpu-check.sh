@@ -62,14 +62,14 @@ check() {
     # of the CPU's vector width are timed too.
     local core=Haswell
     grep -qm1 avx512f /proc/cpuinfo && core=SkylakeX
+    direct() { run_prog 60 edgefem_bench_solvers --parts direct --rounds 3 2>&1 | grep -E "^\| (Eigen|CHOLMOD)|BLAS"; }
     echo "-- serial OpenBLAS, its own choice of kernels"
-    run_prog 60 edgefem_bench_solvers --parts direct --rounds 3 2>&1 | grep -E "^\| (Eigen|CHOLMOD)|BLAS"
+    direct
     echo "-- serial OpenBLAS, OPENBLAS_CORETYPE=$core"
-    OPENBLAS_CORETYPE=$core run_prog 60 edgefem_bench_solvers --parts direct --rounds 3 2>&1 | grep -E "^\| (Eigen|CHOLMOD)|BLAS"
+    OPENBLAS_CORETYPE=$core direct
     if [ -n "${LAUNCH_PTHREAD:-}" ]; then
         echo "-- threaded OpenBLAS, OPENBLAS_CORETYPE=$core OPENBLAS_NUM_THREADS=$(nproc)"
-        OPENBLAS_CORETYPE=$core OPENBLAS_NUM_THREADS=$(nproc) LAUNCH=$LAUNCH_PTHREAD run_prog 60 edgefem_bench_solvers \
-            --parts direct --rounds 3 2>&1 | grep -E "^\| (Eigen|CHOLMOD)|BLAS"
+        OPENBLAS_CORETYPE=$core OPENBLAS_NUM_THREADS=$(nproc) LAUNCH=$LAUNCH_PTHREAD direct
     fi
     echo "== Solvers on every core: block-Jacobi against AMG per step, bunny-250k at 1 ms, $(nproc) threads"
     run_prog 150 edgefem_bench_solvers --parts step --meshes bunny-250k --dts 1 --rounds 1 --threads "$(nproc)" 2>&1 | grep -E "^\| bunny"
@@ -113,7 +113,8 @@ pack)
         for e in node ele; do [ -f "$mesh_dir/$m.$e" ] && gzip -6 -c "$mesh_dir/$m.$e" > "$B/meshes/$m.$e.gz"; done
     done
     # Compressed, so that the bundle travels within the device tool's 64 MiB.
-    gzip -9 "$B"/bin/* "$B"/lib/* "$B"/lib-pthread/* 2>/dev/null
+    gzip -9 "$B"/bin/* "$B"/lib/*
+    [ -d "$B/lib-pthread" ] && gzip -9 "$B"/lib-pthread/*
     cp scripts/gpu-check.sh "$B/gpu-check.sh"
     cat > "$B/run.sh" <<'RUN'
 #!/bin/bash

@@ -10,11 +10,12 @@
 
 namespace edgefem::test {
 
-// nx x ny x nz cubes, Young's modulus `young` (Poisson 0.3, density 1000),
-// the vertices at the smallest x fixed; integrator and solver defaults.
-inline Scene clamped_box_scene(int nx, int ny, int nz, double young = 2e4) {
+// nx x ny x nz cubes of `cell` metres, Young's modulus `young` (Poisson 0.3,
+// density 1000), the vertices at the smallest x fixed; integrator and solver
+// defaults.
+inline Scene clamped_box_scene(int nx, int ny, int nz, double young = 2e4, double cell = 0.01) {
     Scene s;
-    s.mesh = make_box(nx, ny, nz);
+    s.mesh = make_box(nx, ny, nz, cell);
     s.materials = Material{young, 0.3, 1000};
     s.gravity = {0, 0, -9.81};
     double xmin = std::numeric_limits<double>::infinity();
@@ -22,6 +23,19 @@ inline Scene clamped_box_scene(int nx, int ny, int nz, double young = 2e4) {
     for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
         if (s.mesh.X[3 * v] < xmin + 1e-9) s.fixed.push_back(v);
     return s;
+}
+
+// Released from a bend about the clamped end x = x0: u_z = r L t^2, t = (x -
+// x0) / L, L the box's length, r the tip's displacement over L.
+inline void bend_from_clamp(Scene& s, double r) {
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0;
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
+        x0 = std::min(x0, s.mesh.X[3 * v]), x1 = std::max(x1, s.mesh.X[3 * v]);
+    s.initial_displacement.assign(s.mesh.X.size(), 0.0);
+    for (index_t v = 0; v < s.mesh.num_vertices(); ++v) {
+        const double t = (s.mesh.X[3 * v] - x0) / (x1 - x0);
+        s.initial_displacement[3 * std::size_t(v) + 2] = r * (x1 - x0) * t * t;
+    }
 }
 
 // The stress suite's nearly incompressible bar: 6 x 2 x 2 cubes, Y = 1e5 Pa,
@@ -38,14 +52,7 @@ inline Scene bent_incompressible_bar(Integrator integrator, double rho_inf, int 
     s.dt = 1e-3;
     s.solver.max_energy_growth = 2;
     s.solver.max_step_halvings = halvings;
-    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0;
-    for (index_t v = 0; v < s.mesh.num_vertices(); ++v)
-        x0 = std::min(x0, s.mesh.X[3 * v]), x1 = std::max(x1, s.mesh.X[3 * v]);
-    s.initial_displacement.assign(s.mesh.X.size(), 0.0);
-    for (index_t v = 0; v < s.mesh.num_vertices(); ++v) {
-        const double t = (s.mesh.X[3 * v] - x0) / (x1 - x0);
-        s.initial_displacement[3 * std::size_t(v) + 2] = 0.2 * (x1 - x0) * t * t;
-    }
+    bend_from_clamp(s, 0.2);
     return s;
 }
 

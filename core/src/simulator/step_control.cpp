@@ -48,7 +48,7 @@ void StepControl<S>::advance(double T, int depth) {
         s_.copy_state(s_.v, depth == 0 ? step_start_v_ : v_save);
         s_.copy_history(s_.history, depth == 0 ? step_start_history_ : history_save);
         ++s_.stats.halvings;
-        deepest_ = std::max(deepest_, depth + 1);
+        s_.stats.substep_depth = std::max(s_.stats.substep_depth, depth + 1);
         advance(T / 2, depth + 1);
         advance(T / 2, depth + 1);
     }
@@ -67,7 +67,7 @@ const StepStats& StepControl<S>::step() {
     s_.copy_history(step_start_history_, s_.history);
     try {
         // 2^depth_ pieces (a piece past depth 0 keeps its own start to retry from).
-        deepest_ = depth_;
+        s_.stats.substep_depth = depth_;
         const int pieces = 1 << depth_;
         for (int k = 0; k < pieces; ++k) advance(s_.scene.dt / pieces, depth_);
     } catch (const StepFailure& failure) {
@@ -79,8 +79,7 @@ const StepStats& StepControl<S>::step() {
         throw SimulationError(failure.message, s_.step + 1, failure.vertex);
     }
     s_.time = t_start + s_.scene.dt;  // no drift from summed halves
-    s_.stats.substep_depth = deepest_;
-    remember(s_.stats.halvings > 0 ? deepest_ : -1);
+    remember(s_.stats.halvings > 0 ? s_.stats.substep_depth : -1);
     ++s_.step;
     if (s_.scene.count_inverted_tets) s_.stats.inverted_tets = s_.op->inverted_tets(s_.u.data());
     if (s_.scene.solver.fail_on_inverted && s_.stats.inverted_tets > 0)

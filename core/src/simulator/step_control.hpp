@@ -46,8 +46,8 @@ private:
     // The remembered halving: steps start as 2^depth_ pieces; stay_ more
     // steps before one level less; hold_ the steps a level is kept after a
     // failure; since_up_ the steps since the last return to a shallower
-    // level; deepest_ the depth the current step reached.
-    int depth_ = 0, stay_ = 0, hold_ = kFirstHold, deepest_ = 0;
+    // level (the depth the current step reached: StepStats::substep_depth).
+    int depth_ = 0, stay_ = 0, hold_ = kFirstHold;
     long since_up_ = kRepeatWindow;  // a first failure is no repeat
 };
 
