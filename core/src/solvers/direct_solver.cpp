@@ -26,8 +26,8 @@ public:
         factored_ = matrix_.lower_free().n == 0 || chol_.factor(matrix_.lower_free());
     }
 
-    CgResult solve(LinearSystem<S>& A, BackendVector<double>& b_vec, BackendVector<double>& x_vec, double,
-                   int) override {
+    CgResult solve(LinearSystem<S>& A, BackendVector<double>& b_vec, BackendVector<double>& x_vec, double, int,
+                   const double*) override {
         CgResult res;
         const std::size_t n = s_.n();
         const std::span<const double> b = b_vec.host();

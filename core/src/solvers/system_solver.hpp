@@ -29,9 +29,12 @@ public:
     virtual void save(CheckpointWriter& /*w*/) const {}
     virtual void load(CheckpointReader& /*r*/, LinearSystem<S>& /*A*/) {}
     // x holds a warm start; `fixed_iterations` > 0: exactly that many
-    // iterations (iterative solvers).
+    // iterations (iterative solvers). `direction` (3 #V, zero on
+    // constrained dofs; may be null): a direction in which the warm start
+    // may be improved first (an iterative solver without a fixed budget
+    // moves x along it to the least A-norm error: CgSolver).
     virtual CgResult solve(LinearSystem<S>& A, BackendVector<double>& b, BackendVector<double>& x, double tolerance,
-                           int fixed_iterations) = 0;
+                           int fixed_iterations, const double* direction = nullptr) = 0;
 };
 
 // The scene's SolverSettings::linear_solver.

@@ -9,12 +9,12 @@ TangentSolve<S>::TangentSolve(SimState<S>& state) : s_(state), system_(state), s
 
 template <class S>
 CgResult TangentSolve<S>::solve(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
-                                bool definite, bool reuse_stiffness, int fixed_iterations) {
-    CgResult res = solve_once(c_m, c_k, c_b, K0, tolerance, definite, reuse_stiffness, fixed_iterations);
+                                bool definite, bool reuse_stiffness, int fixed_iterations, const double* direction) {
+    CgResult res = solve_once(c_m, c_k, c_b, K0, tolerance, definite, reuse_stiffness, fixed_iterations, direction);
     if (res.negative_curvature && !definite && s_.scene.method == Method::Edge) {
         s_.stats.negative_curvature = true;
         const int its = res.iterations;
-        res = solve_once(c_m, c_k, c_b, K0, tolerance, true, false, fixed_iterations);
+        res = solve_once(c_m, c_k, c_b, K0, tolerance, true, false, fixed_iterations, direction);
         res.iterations += its;
     }
     return res;
@@ -22,7 +22,8 @@ CgResult TangentSolve<S>::solve(double c_m, double c_k, double c_b, const Elasti
 
 template <class S>
 CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0,
-                                     double tolerance, bool definite, bool reuse_stiffness, int fixed_iterations) {
+                                     double tolerance, bool definite, bool reuse_stiffness, int fixed_iterations,
+                                     const double* direction) {
     auto t0 = Clock::now();
     const int refreshes = solver_->refreshes();
     reuse_stiffness = reuse_stiffness && solver_->reusable();
@@ -36,7 +37,7 @@ CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const E
     }
     s_.stats.stiffness_ms += ms_since(t0);
     t0 = Clock::now();
-    const CgResult res = solver_->solve(system_, s_.b, s_.x, tolerance, fixed_iterations);
+    const CgResult res = solver_->solve(system_, s_.b, s_.x, tolerance, fixed_iterations, direction);
     s_.stats.solve_ms += ms_since(t0);
     s_.stats.solver_iterations += res.iterations;
     s_.stats.preconditioner_refreshes += solver_->refreshes() - refreshes;  // set-up and solve (auto switches in it)

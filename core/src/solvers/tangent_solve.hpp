@@ -27,11 +27,13 @@ public:
     // semi-implicit step's budget, cg_fixed_iterations; Newton's solves
     // always run to their tolerance: with the budget they failed to
     // converge).
+    // `direction`: SystemSolver::solve's (the warm start improved along it).
     CgResult solve(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance, bool definite,
-                   bool reuse_stiffness = false, int fixed_iterations = 0);
+                   bool reuse_stiffness = false, int fixed_iterations = 0, const double* direction = nullptr);
     // The same without the retry.
     CgResult solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
-                        bool definite, bool reuse_stiffness = false, int fixed_iterations = 0);
+                        bool definite, bool reuse_stiffness = false, int fixed_iterations = 0,
+                        const double* direction = nullptr);
 
     // For a checkpoint: the solver's set-up that may outlive a step and the
     // lagged K (stiffness_interval > 1); load() rebuilds them.

@@ -77,6 +77,32 @@ public:
             u[i] += S(T * x[i]);
         });
     }
+    void velocity_change(double* d, double* v_prev, const S* v, const std::uint8_t* free_dof,
+                         std::size_t n) const override {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
+            const double now = double(v[i]);
+            d[i] = free_dof[i] ? now - v_prev[i] : 0.0;
+            v_prev[i] = now;
+        });
+    }
+    void axpby(double* y, double a, const double* x, double c, std::size_t n) const override {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { y[i] = a * x[i] + c * y[i]; });
+    }
+    std::array<double, 3> warm_start_sums(const double* d, const double* b, const double* x, const double* Ad,
+                                          std::size_t n) const override {
+        return launch_.reduce(
+            n, std::array<double, 3>{},
+            [=] EDGEFEM_LAMBDA(std::size_t lo, std::size_t hi) {
+                std::array<double, 3> acc{};
+                for (std::size_t i = lo; i < hi; ++i) {
+                    acc[0] += d[i] * b[i];
+                    acc[1] += x[i] * Ad[i];
+                    acc[2] += d[i] * Ad[i];
+                }
+                return acc;
+            },
+            AddArrays{});
+    }
     void implicit_predict(double* u0, double* upred, const S* u, const S* v, double T, std::size_t n) const override {
         launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) {
             u0[i] = double(u[i]);

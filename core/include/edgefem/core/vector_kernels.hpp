@@ -100,6 +100,16 @@ public:
                                    const double* mass, double T, std::size_t n) const = 0;
     // v = x, u += T x.
     virtual void take_velocity(S* u, S* v, const double* x, double T, std::size_t n) const = 0;
+    // The semi-implicit step's warm-start direction: d = v - v_prev on free
+    // dofs, 0 on constrained ones; then v_prev = v.
+    virtual void velocity_change(double* d, double* v_prev, const S* v, const std::uint8_t* free_dof,
+                                 std::size_t n) const = 0;
+    // y = a x + c y.
+    virtual void axpby(double* y, double a, const double* x, double c, std::size_t n) const = 0;
+    // {d.b, x.Ad, d.Ad}: a warm start's improvement along d (plain sums,
+    // in the launch's fixed order).
+    virtual std::array<double, 3> warm_start_sums(const double* d, const double* b, const double* x, const double* Ad,
+                                                  std::size_t n) const = 0;
     // u0 = u, upred = u0 + T v.
     virtual void implicit_predict(double* u0, double* upred, const S* u, const S* v, double T,
                                   std::size_t n) const = 0;
