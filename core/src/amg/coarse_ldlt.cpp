@@ -6,7 +6,13 @@
 // warning off for this file only (its only dense kernels are these two).
 #include <Eigen/Dense>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace edgefem::amg {
 
@@ -87,25 +93,109 @@ bool CoarseLdlt::factor(const SparseRows& A) {
         lower_, d_, negative_);
 }
 
+namespace {
+// W doubles, the target's widest vector (8 with AVX-512, 4 with AVX, 2
+// otherwise; GCC/Clang vector extensions), loaded unaligned; from floats
+// converted.
+#if defined(__AVX512F__)
+constexpr std::size_t W = 8;
+#elif defined(__AVX__)
+constexpr std::size_t W = 4;
+#else
+constexpr std::size_t W = 2;
+#endif
+using Dv = double __attribute__((vector_size(8 * W)));
+constexpr std::size_t kBlock = 8;  // rows (columns of L^T) per block: a multiple of W
+inline Dv load_d(const double* p) {
+    Dv v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+// One conversion instruction (g++ 12 splits __builtin_convertvector into
+// halves and inserts: 10-20 % slower here).
+inline Dv load_f(const float* p) {
+#if defined(__AVX512F__)
+    return Dv(_mm512_cvtps_pd(_mm256_loadu_ps(p)));
+#elif defined(__AVX__)
+    return Dv(_mm256_cvtps_pd(_mm_loadu_ps(p)));
+#elif defined(__SSE2__)
+    return Dv(_mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)))));  // two floats
+#else
+    using Fv = float __attribute__((vector_size(4 * W)));
+    Fv v;
+    std::memcpy(&v, p, sizeof v);
+    return __builtin_convertvector(v, Dv);
+#endif
+}
+inline double lane_sum(const Dv& a) {  // a fixed order
+    double s = 0;
+    for (std::size_t k = 0; k < W; ++k) s += a[k];
+    return s;
+}
+}  // namespace
+
+// Both triangular solves go through L in blocks of 8 rows (forward) or 8
+// columns of L^T (backward). Left of its diagonal block a block is 8 dot
+// products over the same stretch of y (forward) or one pass over y with 8
+// multiply-adds per entry (backward): 8 independent sums in registers,
+// where a row at a time was one chain of dependent adds (30 -> 16 us on
+// bunny-4k's 462-dof level, docs/solvers.md). The diagonal blocks go row
+// by row. Every sum has a fixed order: the same bits on every call.
 void CoarseLdlt::solve(const double* b, double* x) const {
     double* y = y_.data();
-    // y = L^-1 P b, row by row; each row's sum in four interleaved partial
-    // sums (a fixed order: the same bits on every call)
-    for (std::size_t i = 0; i < n_; ++i) {
-        const float* row = &lower_[i * (i - (i > 0)) / 2];
-        double s[4] = {0, 0, 0, 0};
-        std::size_t j = 0;
-        for (; j + 4 <= i; j += 4)
-            for (int q = 0; q < 4; ++q) s[q] += double(row[j + std::size_t(q)]) * y[j + std::size_t(q)];
-        for (; j < i; ++j) s[0] += double(row[j]) * y[j];
-        y[i] = b[perm_[i]] - ((s[0] + s[1]) + (s[2] + s[3]));
+    const auto row = [this](std::size_t i) { return &lower_[i * (i - (i > 0)) / 2]; };
+    // y = L^-1 P b
+    for (std::size_t i0 = 0; i0 < n_; i0 += kBlock) {
+        const std::size_t rows = std::min(kBlock, n_ - i0);
+        double left[kBlock] = {};
+        if (rows == kBlock) {  // i0 is a multiple of 8: whole vectors
+            const float* r[kBlock];
+            Dv acc[kBlock] = {};
+            for (std::size_t q = 0; q < kBlock; ++q) r[q] = row(i0 + q);
+            for (std::size_t j = 0; j < i0; j += W) {
+                const Dv yv = load_d(y + j);
+                for (std::size_t q = 0; q < kBlock; ++q) acc[q] += load_f(r[q] + j) * yv;
+            }
+            for (std::size_t q = 0; q < kBlock; ++q) left[q] = lane_sum(acc[q]);
+        } else {
+            for (std::size_t q = 0; q < rows; ++q) {
+                const float* r = row(i0 + q);
+                for (std::size_t j = 0; j < i0; ++j) left[q] += double(r[j]) * y[j];
+            }
+        }
+        for (std::size_t q = 0; q < rows; ++q) {
+            const std::size_t i = i0 + q;
+            const float* r = row(i);
+            double s = left[q];
+            for (std::size_t j = i0; j < i; ++j) s += double(r[j]) * y[j];
+            y[i] = b[perm_[i]] - s;
+        }
     }
     for (std::size_t i = 0; i < n_; ++i) y[i] /= d_[i];
-    // L^-T, column-oriented: row j of the packed L is column j of L^T
-    for (std::size_t j = n_; j-- > 1;) {
-        const float* row = &lower_[j * (j - 1) / 2];
-        const double yj = y[j];
-        for (std::size_t i = 0; i < j; ++i) y[i] -= double(row[i]) * yj;
+    // L^-T: row j of the packed L is column j of L^T; blocks of columns
+    // from the last
+    for (std::size_t i1 = n_; i1 > 0;) {
+        const std::size_t i0 = ((i1 - 1) / kBlock) * kBlock;
+        for (std::size_t j = i1; j-- > i0 + 1;) {  // the block's own triangle
+            const float* r = row(j);
+            for (std::size_t i = i0; i < j; ++i) y[i] -= double(r[i]) * y[j];
+        }
+        if (i1 - i0 == kBlock) {
+            const float* r[kBlock];
+            for (std::size_t q = 0; q < kBlock; ++q) r[q] = row(i0 + q);
+            for (std::size_t i = 0; i < i0; i += W) {  // i0 is a multiple of 8
+                Dv p[kBlock];
+                for (std::size_t q = 0; q < kBlock; ++q) p[q] = load_f(r[q] + i) * y[i0 + q];
+                const Dv s = load_d(y + i) - (((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7])));
+                std::memcpy(y + i, &s, sizeof s);
+            }
+        } else {
+            for (std::size_t q = i0; q < i1; ++q) {
+                const float* r = row(q);
+                for (std::size_t i = 0; i < i0; ++i) y[i] -= double(r[i]) * y[q];
+            }
+        }
+        i1 = i0;
     }
     for (std::size_t k = 0; k < n_; ++k) x[perm_[k]] = y[k];
 }
