@@ -119,7 +119,9 @@ inline Dv load_f(const float* p) {
 #elif defined(__AVX__)
     return Dv(_mm256_cvtps_pd(_mm_loadu_ps(p)));
 #elif defined(__SSE2__)
-    return Dv(_mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)))));  // two floats
+    double two;  // two floats' bytes
+    std::memcpy(&two, p, sizeof two);
+    return Dv(_mm_cvtps_pd(_mm_castpd_ps(_mm_set_sd(two))));
 #else
     using Fv = float __attribute__((vector_size(4 * W)));
     Fv v;
@@ -143,7 +145,7 @@ inline double lane_sum(const Dv& a) {  // a fixed order
 // by row. Every sum has a fixed order: the same bits on every call.
 void CoarseLdlt::solve(const double* b, double* x) const {
     double* y = y_.data();
-    const auto row = [this](std::size_t i) { return &lower_[i * (i - (i > 0)) / 2]; };
+    const auto row = [this](std::size_t i) { return lower_.data() + i * (i - (i > 0)) / 2; };
     // y = L^-1 P b
     for (std::size_t i0 = 0; i0 < n_; i0 += kBlock) {
         const std::size_t rows = std::min(kBlock, n_ - i0);
