@@ -22,6 +22,22 @@ void block_columns(const SparseRows& A, std::size_t I, int b, std::vector<int>& 
         }
 }
 
+// Whether the rb rows of A's block row I hold the same columns, in runs of
+// rb that are whole blocks (columns J rb .. J rb + rb - 1).
+template <int rb>
+bool whole_blocks(const int* outer, const int* inner, std::size_t I) {
+    const int r0 = outer[I * rb], len = outer[I * rb + 1] - r0;
+    if (len % rb != 0) return false;
+    for (int r = 1; r < rb; ++r)
+        if (outer[I * rb + std::size_t(r) + 1] - outer[I * rb + std::size_t(r)] != len ||
+            !std::equal(inner + r0, inner + r0 + len, inner + outer[I * rb + std::size_t(r)]))
+            return false;
+    for (int m = 0; m < len; m += rb)
+        for (int j = 0; j < rb; ++j)
+            if (inner[r0 + m + j] != (inner[r0 + m] / rb) * rb + j) return false;
+    return true;
+}
+
 // What multiply_blocks reads and writes of a GalerkinProduct.
 struct Work {
     const std::vector<int>& start;  // the result's block pattern
@@ -39,27 +55,57 @@ template <int RB, int CB>
 bool multiply_blocks(const SparseRows& A, const BlockRowsView& P, const Work& o) {
     constexpr int rb = RB, cb = CB;
     constexpr std::size_t w = std::size_t(rb) * std::size_t(cb);
+    const bool compressed = A.isCompressed();  // outer[i + 1] ends row i
+    const int* outer = A.outerIndexPtr();
+    const int* inner = A.innerIndexPtr();
+    const double* value = A.valuePtr();
+    // The scratch block of coarse block c in the current row of A P (zeroed
+    // when c first appears in the row).
+    const auto block_of = [&](int c) {
+        if (o.slot[std::size_t(c)] < 0) {
+            o.slot[std::size_t(c)] = int(o.cols.size());
+            o.cols.push_back(c);
+            if (o.scratch.size() < o.cols.size() * w) o.scratch.resize(o.cols.size() * w);
+            std::fill_n(o.scratch.begin() + std::ptrdiff_t((o.cols.size() - 1) * w), w, 0.0);
+        }
+        return o.scratch.data() + std::size_t(o.slot[std::size_t(c)]) * w;
+    };
     for (std::size_t I = 0; I < P.block_rows; ++I) {
         // Row I of A P: rb x cb per coarse block, summed over A's entries.
         o.cols.clear();
-        for (int r = 0; r < rb; ++r)
-            for (SparseRows::InnerIterator it(A, Eigen::Index(I) * rb + r); it; ++it) {
-                const std::size_t J = std::size_t(it.col() / rb);
-                const int j = int(it.col() % rb);
-                const double v = it.value();
+        if (compressed && whole_blocks<rb>(outer, inner, I)) {
+            // A's rb rows hold the same whole rb x rb blocks (the assembled
+            // fine level and every Galerkin operator): per block, one
+            // look-up per block of P's row and rb x rb x cb multiply-adds
+            const int r0 = outer[I * rb], len = outer[I * rb + 1] - r0;
+            for (int m = 0; m < len; m += rb) {
+                const std::size_t J = std::size_t(inner[r0 + m] / rb);
+                double a[rb][rb];
+                for (int r = 0; r < rb; ++r)
+                    for (int j = 0; j < rb; ++j) a[r][j] = value[outer[I * rb + std::size_t(r)] + m + j];
                 for (int k = P.start[J]; k < P.start[J + 1]; ++k) {
-                    const int c = P.col[k];
-                    if (o.slot[std::size_t(c)] < 0) {
-                        o.slot[std::size_t(c)] = int(o.cols.size());
-                        o.cols.push_back(c);
-                        if (o.scratch.size() < o.cols.size() * w) o.scratch.resize(o.cols.size() * w);
-                        std::fill_n(o.scratch.begin() + std::ptrdiff_t((o.cols.size() - 1) * w), w, 0.0);
-                    }
-                    double* s = o.scratch.data() + std::size_t(o.slot[std::size_t(c)]) * w + std::size_t(r) * std::size_t(cb);
-                    const float* p = P.val + std::size_t(k) * w + std::size_t(j) * std::size_t(cb);
-                    for (int y = 0; y < cb; ++y) s[y] += v * double(p[y]);
+                    double* s = block_of(P.col[k]);
+                    const float* p = P.val + std::size_t(k) * w;
+                    for (int r = 0; r < rb; ++r)
+                        for (int j = 0; j < rb; ++j) {
+                            const double v = a[r][j];
+                            for (int y = 0; y < cb; ++y) s[r * cb + y] += v * double(p[j * cb + y]);
+                        }
                 }
             }
+        } else {
+            for (int r = 0; r < rb; ++r)
+                for (SparseRows::InnerIterator it(A, Eigen::Index(I) * rb + r); it; ++it) {
+                    const std::size_t J = std::size_t(it.col() / rb);
+                    const int j = int(it.col() % rb);
+                    const double v = it.value();
+                    for (int k = P.start[J]; k < P.start[J + 1]; ++k) {
+                        double* s = block_of(P.col[k]) + std::size_t(r) * std::size_t(cb);
+                        const float* p = P.val + std::size_t(k) * w + std::size_t(j) * std::size_t(cb);
+                        for (int y = 0; y < cb; ++y) s[y] += v * double(p[y]);
+                    }
+                }
+        }
         // P's blocks of row I, transposed, times it, into the blocks on and
         // above the diagonal.
         bool covered = true;
@@ -80,13 +126,17 @@ bool multiply_blocks(const SparseRows& A, const BlockRowsView& P, const Work& o)
                 }
                 const std::size_t k = std::size_t(pos - first);
                 const double* s = o.scratch.data() + t * w;
-                for (int x = 0; x < cb; ++x) {
-                    double* out = o.val + o.outer[a * std::size_t(cb) + std::size_t(x)] + k * std::size_t(cb);
+                // the block P_Ia^T (A P)_It in registers (no aliasing with
+                // the result: vectorised), then added
+                double block[cb * cb] = {};
+                for (int x = 0; x < cb; ++x)
                     for (int r = 0; r < rb; ++r) {
                         const double pr = pt[x * rb + r];
-                        const double* sr = s + std::size_t(r) * std::size_t(cb);
-                        for (int y = 0; y < cb; ++y) out[y] += pr * sr[y];
+                        for (int y = 0; y < cb; ++y) block[x * cb + y] += pr * s[r * cb + y];
                     }
+                for (int x = 0; x < cb; ++x) {
+                    double* out = o.val + o.outer[a * std::size_t(cb) + std::size_t(x)] + k * std::size_t(cb);
+                    for (int y = 0; y < cb; ++y) out[y] += block[x * cb + y];
                 }
             }
         }

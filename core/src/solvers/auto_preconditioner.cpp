@@ -13,7 +13,7 @@
 // finest level's matrix, plus one (Preconditioner::iteration_cost, from the
 // hierarchy's sizes: 6.9 on box-1200, 9.2-10.9 on the beam, bunny-4k and
 // bunny-50k, within 0.8-1.2x of the measured ratios), a refresh of its
-// operators kRefresh (measured: 230-430; docs/solvers.md), a rebuild of its
+// operators kRefresh (350: a tuned value; docs/solvers.md), a rebuild of its
 // hierarchy kBuild (the first build is the switch's set-up: not counted). Where K changes
 // so much from step to step that the AMG refreshes at nearly every step
 // (soft material, long steps), or where its iterations grow (a body folded
@@ -58,9 +58,16 @@ namespace edgefem::sim {
 
 namespace {
 
-constexpr double kRefresh = 350;      // block-Jacobi iterations per AMG refresh (measured 230-430)
+// block-Jacobi iterations per AMG refresh: measured 230-430 when it was
+// chosen, 105-210 since the Galerkin product went block by block
+// (2026-11-28); 175 made `auto` 1.21-1.29x the best in two cells of
+// docs/solvers.md's table where 350 gives 1.02-1.11 (bunny-4k at 1e6 Pa
+// and 4 ms, bunny-50k at 1e4 Pa and 33 ms; lab/2026-11-28-coarsest-solve.md):
+// kept as a tuned value
+constexpr double kRefresh = 350;
 constexpr double kBuild = 420;        // and per rebuild of its hierarchy (SmoothedAggregation::rebuild: measured
-                                      // 1.13-1.36 refreshes; the first, whole build, 1.7-1.8, is paid at the switch)
+                                      // 1.13-1.36 refreshes then, 1.24-1.47 now; the first, whole build, 1.7-1.8
+                                      // then, 2.2-2.5 now, is paid at the switch)
 constexpr int kWindow = 8;            // AMG solves its cost is judged over
 constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
 constexpr int kHold = 8;              // block-Jacobi set-ups after the first going back before AMG may be tried again
