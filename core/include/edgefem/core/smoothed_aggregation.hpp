@@ -57,8 +57,8 @@ public:
     // tentative prolongator, the coarse near-nullspace), the smoothed
     // prolongators' values formed into their patterns, then refresh(A)'s
     // work (the Chebyshev smoother's D^-1 and largest eigenvalue are those
-    // the prolongator smoother uses). About a refresh's cost where build()
-    // costs 1.6-1.9 (docs/solvers.md). The aggregates of build() come from A's
+    // the prolongator smoother uses). 1.2-1.5 refreshes where build() costs
+    // 2.2-2.5 (docs/solvers.md). The aggregates of build() come from A's
     // strong couplings then: a fresh build() on a deformed body may group
     // differently (on a body turned rigidly it does not). Returns false
     // where a prolongator's value fell outside build()'s pattern (a block
