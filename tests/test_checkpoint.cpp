@@ -58,7 +58,7 @@ Scene case_scene(const Case& c, bool single = false) {
     s.solver.cg_max_iterations = 2000;
     if (c.damping_and_prescribed) {
         s.rayleigh_alpha = 0.5;
-        if (!is_explicit(c.integrator)) s.rayleigh_beta = 2e-3;
+        if (c.integrator != Integrator::Verlet) s.rayleigh_beta = 2e-3;
         double xmax = -1;
         for (index_t v = 0; v < s.mesh.num_vertices(); ++v) xmax = std::max(xmax, s.mesh.X[3 * v]);
         for (index_t v = 0; v < s.mesh.num_vertices(); ++v)

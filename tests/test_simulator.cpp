@@ -299,7 +299,7 @@ TEST(Simulator, FloatTracksDoubleAndSceneErrorsNameTheField) {
     s = cantilever(Integrator::SemiImplicit, 1e-3);
     s.fixed.push_back(100000);
     expect_field(s, "fixed[");
-    s = cantilever(Integrator::Explicit, 1e-3);
+    s = cantilever(Integrator::Verlet, 1e-3);
     s.rayleigh_beta = 0.1;
     expect_field(s, "damping.beta");
     s = cantilever(Integrator::SemiImplicit, 1e-3);

@@ -314,6 +314,13 @@ Scene explicit_scene() {
     return s;
 }
 
+// With stiffness damping: a K built and applied in every explicit step.
+Scene explicit_damped_scene() {
+    Scene s = explicit_scene();
+    s.rayleigh_beta = 2e-4;
+    return s;
+}
+
 SimRun simulate(const Scene& scene, std::shared_ptr<const Backend<double>> backend, int steps,
              bool static_first = false) {
     Simulator<double> sim(scene, std::move(backend));
@@ -459,6 +466,7 @@ TEST(Backends, SimulatorOnReferenceAndCpuAgree) {
     std::vector<Case> cases{{"semi-implicit", semi_implicit_scene(), 4, false},
                             {"implicit", implicit_scene(), 3, false},
                             {"explicit", explicit_scene(), 20, false},
+                            {"explicit, beta", explicit_damped_scene(), 20, false},
                             {"static", test::clamped_box_scene(8, 3, 3), 1, true}};
     const auto omp2 = make_executor(ExecutorKind::OpenMP, 2);
     for (const Case& c : cases) {
@@ -511,7 +519,8 @@ TEST(Backends, DeviceMemoryIsNeverReadOnTheHostInAStep) {
     const auto device = std::make_shared<PretendDeviceBackend>();
     for (const auto& [scene, steps, static_first] :
          {std::tuple{semi_implicit_scene(), 3, false}, std::tuple{implicit_scene(), 2, false},
-          std::tuple{explicit_scene(), 5, false}, std::tuple{test::clamped_box_scene(8, 3, 3), 1, true}}) {
+          std::tuple{explicit_scene(), 5, false}, std::tuple{explicit_damped_scene(), 5, false},
+          std::tuple{test::clamped_box_scene(8, 3, 3), 1, true}}) {
         // block-Jacobi on both: "auto" never takes the host-only AMG off the
         // host, and would take it on the CPU where a solve needs > 100 its
         Scene scene_bj = scene;

@@ -137,8 +137,9 @@ void Scene::validate() const {
         if (!std::isfinite(gravity[r])) bad("gravity", "non-finite component");
     non_negative("damping.alpha", rayleigh_alpha);
     non_negative("damping.beta", rayleigh_beta);
-    if (rayleigh_beta > 0 && is_explicit(integrator))
-        bad("damping.beta", "stiffness-proportional damping needs an implicit integrator (explicit steps never build K)");
+    if (rayleigh_beta > 0 && integrator == Integrator::Verlet)
+        bad("damping.beta", "stiffness-proportional damping needs the explicit (symplectic Euler) or an implicit "
+                            "integrator (verlet never builds K)");
     if (model == ModelKind::SN && method == Method::Tet) bad("model", "the spring network exists only for the edge method");
     if (solver.definite_stiffness && method == Method::Tet)
         bad("solver.definite_stiffness", "the definite tangent exists only for the edge method");

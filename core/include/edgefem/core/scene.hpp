@@ -18,7 +18,7 @@
 namespace edgefem {
 
 enum class Integrator {
-    Explicit,      // symplectic Euler: never builds K
+    Explicit,      // symplectic Euler: builds K only for stiffness damping (beta)
     SemiImplicit,  // linearised backward Euler, one K per step, CG (the talk's form)
     Implicit,      // backward Euler solved by Newton with line search
     // Second order (docs/dynamics.md, "Integrators"). The implicit ones come
@@ -154,7 +154,7 @@ struct Scene {
     Method method = Method::Edge;
     std::array<double, 3> gravity{0, 0, 0};  // m/s^2
     double rayleigh_alpha = 0;               // D = alpha M + beta K
-    double rayleigh_beta = 0;
+    double rayleigh_beta = 0;                // not with verlet; explicit builds K for it
     std::vector<index_t> fixed;              // held at their rest position
     std::vector<Prescribed> prescribed;      // moved linearly from rest to target
     int prescribed_steps = 1;                // dynamics: steps over which targets are reached
