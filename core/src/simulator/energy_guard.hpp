@@ -31,7 +31,10 @@ struct EnergySample {
 template <class S>
 class EnergyGuard {
 public:
-    explicit EnergyGuard(SimState<S>& state) : s_(state), u_evaluated_(state.template vector<S>(0)) {}
+    explicit EnergyGuard(SimState<S>& state)
+        : s_(state), u_evaluated_(state.template vector<S>(0)), v_free_(state.template vector<double>(0)),
+          v_con_(state.template vector<double>(0)), kv_(state.template vector<double>(0)),
+          in_(state.template vector<S>(0)), out_(state.template vector<S>(0)) {}
     bool enabled() const { return s_.scene.solver.max_energy_growth > 0; }
 
     // The state at the start of a step. The elastic energy comes from the
@@ -45,7 +48,9 @@ public:
     // Whether a step from the current state to t_end moves a fixed or
     // prescribed vertex (a prescribed ramp, or a vertex the application
     // displaced). Such a step's gain is the free vertices' energy change
-    // less the constraints' work, f_c . du_c by the trapezoidal rule.
+    // less the constraints' work, f_c . du_c by the trapezoidal rule, and
+    // with stiffness damping (beta) less what they did through it, -T beta
+    // v_f . K v_c (damping_drag).
     bool constraints_move(double t_end) const;
 
     // After a failed step: its force passes (Newton's iterates) have
@@ -73,6 +78,7 @@ public:
 private:
     EnergySample sample(double W) const;
     void constrained(EnergySample& e, const S* u_from, double fraction) const;
+    double damping_drag(double T);
 
     SimState<S>& s_;
     BackendVector<S> u_evaluated_;  // the u that f, the operator's state and W_evaluated_ belong to
@@ -80,6 +86,8 @@ private:
     bool evaluated_valid_ = false;
     double energy_excess_ = 0;  // energy gained net of work since its lowest level (>= 0)
     double energy_scale_ = 0;   // largest kinetic + elastic energy seen
+    BackendVector<double> v_free_, v_con_, kv_;  // damping_drag's work (3 #V when used)
+    BackendVector<S> in_, out_;                   // and its float products
 };
 
 extern template class EnergyGuard<double>;
