@@ -1,6 +1,7 @@
 // `edgefem accuracy`: run time against error on standard dynamic scenes.
 //
-// Scenes (no damping, so energy drift is purely numerical):
+// Scenes (no damping but in the two damped ones, so energy drift is
+// purely numerical):
 //  cantilever  box 12x3x3 (0.12 m, 648 tets), Y = 2e5, nu = 0.35, clamped at
 //              x = min, released from rest under gravity -z;
 //  twist       box 10x2x2 (0.1 m, 240 tets), Y = 1e5, nu = 0.3, clamped at
@@ -23,7 +24,11 @@
 //              explicit stable step halves, the motion does not change;
 //  shake-finer and of 1.25 mm cells (192x12x12, 165,888 tets), only by
 //              --scene (about 30 min), against a velocity Verlet reference;
-//  shake-rubber shake's beam with nu = 0.49, only by --scene (1 min).
+//  shake-rubber shake's beam with nu = 0.49, only by --scene (1 min);
+//  shake-damped, bunny-damped, cantilever-damped  shake, the bunny and
+//              the cantilever with Rayleigh stiffness damping beta = 1e-3 s
+//              (not in --quick): the explicit step builds K for it and is
+//              stable only far below its undamped step.
 // The stiff ones (slender to shake-rubber) are where the explicit stable
 // step is far below the step the motion needs: a fine, thin or nearly
 // incompressible body, whose fastest (pressure) wave crosses a cell in
@@ -254,6 +259,32 @@ std::vector<AccScene> make_scenes(bool quick, const std::string& mesh_folder, co
         out.back().dt_ref = 5e-6;
         out.back().costly = true;
     }
+    // Damped: Rayleigh stiffness damping beta = 1e-3 s (damping.beta), which
+    // damps a mode of angular frequency omega at beta omega / 2 of critical:
+    // lightly the slow bending that is the motion, heavily what a shake or
+    // release sets ringing above it. The explicit step builds and applies K
+    // for it and is stable only below about 2 / (beta omega_max^2)
+    // (integrators/explicit_euler.cpp): about 1.25 us on shake's beam, whose
+    // undamped explicit step is 50 us; Verlet takes no beta. Not in --quick.
+    if ((only.empty() && !quick) || only == "shake-damped") {
+        shaken_beam("shake-damped", "box 48x3x3, 5 mm", 1, {1e-6, 1.25e-6, 2e-6});
+        out.back().scene.rayleigh_beta = 1e-3;
+    }
+    if ((only.empty() && !quick) || only == "bunny-damped") {
+        AccScene c = standing_bunny("bunny-damped", Material{5e4, 0.4, 1000});
+        c.scene.gravity = {0, -9.81, 0};
+        c.scene.rayleigh_beta = 1e-3;
+        c.duration = 0.3 * span;
+        c.samples = int(6 * span);
+        c.dt_ref = 5e-5;
+        c.explicit_dts = {2.5e-5, 3.125e-5, 4e-5};
+        out.push_back(std::move(c));
+    }
+    if ((only.empty() && !quick) || only == "cantilever-damped") {
+        clamped_under_gravity("cantilever-damped", "box 12x3x3", make_box(12, 3, 3, 0.01), Material{2e5, 0.35, 1000},
+                              2e-5, {5e-5, 6.25e-5, 8e-5});
+        out.back().scene.rayleigh_beta = 1e-3;
+    }
     for (auto& s : out) {
         s.scene.count_inverted_tets = false;
         s.scene.rayleigh_alpha = 0;
@@ -280,11 +311,11 @@ void label(std::vector<Config>& cs) {
     }
 }
 
-// The stiff scenes: explicit and Verlet around their stability limit
-// (AccScene::explicit_dts), the first-order implicit ones from 0.25 to 25 ms, the
+// The stiff scenes: explicit and Verlet (not with stiffness damping) around
+// their stability limit (AccScene::explicit_dts), the first-order implicit ones from 0.25 to 25 ms, the
 // second-order implicit ones from 2 to 50 ms. Every step divides the 50 ms
 // between samples (make_configs checks it).
-std::vector<Config> stiff_configs(const std::vector<double>& explicit_dts, bool quick) {
+std::vector<Config> stiff_configs(const std::vector<double>& explicit_dts, bool quick, bool verlet) {
     std::vector<Config> cs;
     auto add = [&](Integrator in, double dt) {
         Config c;
@@ -293,19 +324,22 @@ std::vector<Config> stiff_configs(const std::vector<double>& explicit_dts, bool 
         cs.push_back(c);
     };
     for (Integrator in : {Integrator::Explicit, Integrator::Verlet})
-        for (double dt : quick ? std::vector<double>{explicit_dts.front()} : explicit_dts) add(in, dt);
-    for (double dt : quick ? std::vector<double>{1e-3} : std::vector<double>{2.5e-4, 1e-3, 5e-3, 25e-3})
+        if (in == Integrator::Explicit || verlet)
+            for (double dt : quick ? std::vector<double>{explicit_dts.front()} : explicit_dts) add(in, dt);
+    for (double dt : quick ? std::vector<double>{1e-3} : std::vector<double>{2.5e-4, 5e-4, 1e-3, 5e-3, 25e-3})
         add(Integrator::SemiImplicit, dt);
     if (!quick) add(Integrator::Implicit, 1e-3);
     for (Integrator in : {Integrator::NewmarkLinear, Integrator::GeneralizedAlphaLinear, Integrator::Bdf2Linear})
-        for (double dt : quick ? std::vector<double>{5e-3} : std::vector<double>{2e-3, 5e-3, 10e-3, 25e-3, 50e-3}) add(in, dt);
+        for (double dt : quick ? std::vector<double>{5e-3}
+                               : std::vector<double>{2e-3, 2.5e-3, 3.125e-3, 5e-3, 10e-3, 25e-3, 50e-3})
+            add(in, dt);
     // A loose CG tolerance: the linearised step is one Newton iteration, so
     // a solve to 1e-6 buys accuracy the step's own error (0.1-1 %) hides;
     // under AMG, that is, for block-Jacobi's 1e-2 leaves the smooth part of
     // the error (docs/dynamics.md, "Target (b)").
     for (Integrator in : {Integrator::SemiImplicit, Integrator::NewmarkLinear, Integrator::GeneralizedAlphaLinear})
         for (double dt : quick ? std::vector<double>{5e-3}
-                               : in == Integrator::SemiImplicit ? std::vector<double>{2.5e-4, 1e-3}
+                               : in == Integrator::SemiImplicit ? std::vector<double>{2.5e-4, 5e-4, 1e-3}
                                                                 : std::vector<double>{2e-3, 2.5e-3, 3.125e-3, 5e-3}) {
             add(in, dt);
             cs.back().cg_tol = 1e-2;
@@ -357,13 +391,12 @@ std::vector<Config> make_configs(const AccScene& sc, bool quick) {
 
 std::vector<Config> scene_configs(const AccScene& sc, bool quick) {
     if (sc.costly) return costly_configs(sc.explicit_dts);
-    if (!sc.explicit_dts.empty()) return stiff_configs(sc.explicit_dts, quick);
+    if (!sc.explicit_dts.empty()) return stiff_configs(sc.explicit_dts, quick, sc.scene.rayleigh_beta == 0);
     std::vector<Config> cs;
     auto add = [&](Config c) { cs.push_back(c); };
-    const bool bunny = sc.name == "bunny";
     // Explicit near and below its stability limit.
-    for (double dt : bunny ? std::vector<double>{2.5e-5, 5e-5} : std::vector<double>{5e-5, 1e-4, 2e-4}) {
-        if (quick && dt != (bunny ? 5e-5 : 1e-4)) continue;
+    for (double dt : std::vector<double>{5e-5, 1e-4, 2e-4}) {
+        if (quick && dt != 1e-4) continue;
         Config c;
         c.integrator = Integrator::Explicit;
         c.dt = dt;
@@ -384,8 +417,8 @@ std::vector<Config> scene_configs(const AccScene& sc, bool quick) {
     }
     // The second-order integrators: explicit velocity Verlet at the
     // explicit steps, the implicit ones (Newton and linearised) at 0.5-5 ms.
-    for (double dt : bunny ? std::vector<double>{5e-5} : std::vector<double>{5e-5, 1e-4, 2e-4}) {
-        if (quick && dt != (bunny ? 5e-5 : 1e-4)) continue;
+    for (double dt : {5e-5, 1e-4, 2e-4}) {
+        if (quick && dt != 1e-4) continue;
         Config c;
         c.integrator = Integrator::Verlet;
         c.dt = dt;
@@ -623,7 +656,7 @@ void add_accuracy_command(CLI::App& app) {
     cmd->add_option("--cache", opts->cache, "Folder for the cached reference trajectories (default: build/accuracy-cache)")
         ->check(non_empty_path());
     cmd->add_option("--json", opts->json, "Write the results as JSON to this file")->check(non_empty_path());
-    cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny", "slender", "press", "shake", "shake-rubber", "shake-fine", "shake-finer"}));
+    cmd->add_option("--scene", opts->scene, "Only this scene")->check(CLI::IsMember({"cantilever", "twist", "bunny", "slender", "press", "shake", "shake-rubber", "shake-fine", "shake-finer", "shake-damped", "bunny-damped", "cantilever-damped"}));
     cmd->add_option("--mesh-dir", opts->mesh_dir,
                     "Folder with bunny-4k.node/.ele (default: $EDGEFEM_MESH_DIR, else ../shared/meshes next to the repository)")
         ->check(non_empty_path());
