@@ -567,7 +567,14 @@ std::uint64_t scene_hash(const AccScene& sc, const Config& ref) {
     const double nums[] = {m.young, m.poisson, m.density, s.gravity[0], s.gravity[1], s.gravity[2], sc.duration,
                            double(sc.samples), ref.dt, s.solver.newton_tolerance, s.solver.cg_tolerance,
                            ref.integrator == Integrator::Newmark ? 4.0 /*format: newmark*/ : 100.0 + double(int(ref.integrator))};
-    return fnv1a(nums, sizeof nums, h);
+    h = fnv1a(nums, sizeof nums, h);
+    // Damping only where there is some: the undamped scenes keep the keys
+    // their cached references were made under.
+    if (s.rayleigh_alpha != 0 || s.rayleigh_beta != 0) {
+        const double damping[] = {s.rayleigh_alpha, s.rayleigh_beta};
+        h = fnv1a(damping, sizeof damping, h);
+    }
+    return h;
 }
 
 bool load_reference(const std::string& path, std::size_t n, int samples, Trajectory& tr) {
