@@ -3,7 +3,9 @@
 // and its reason.
 //
 // Every case runs on a small generated mesh (double precision, serial) with
-// mass-proportional damping alpha = 10 /s, no gravity, the library's default
+// mass-proportional damping alpha = 10 /s (the full suite's
+// compress-20%-beta adds stiffness damping beta = 1e-3 s, without verlet,
+// which takes no beta), no gravity, the library's default
 // solver settings except solver.max_step_halvings = 3 and the simulator's
 // energy guard set to the suite's own bound (solver.max_energy_growth =
 // kEnergyGrowthFactor), so the rest shape is the only equilibrium it should
@@ -53,7 +55,7 @@ const char* to_string(StressVerdict v);     // "pass", "failed cleanly", "report
 const char* to_string(StressExpectation e); // "pass", "fail", "either"
 
 struct StressResult {
-    std::string group;        // dt, young, poisson, compress, invert, noise, sliver, twist
+    std::string group;        // dt, young, poisson, compress, damping, invert, noise, sliver, twist
     std::string name;         // e.g. "dt=1/30", "young=1e9"
     std::string integrator;   // to_string(Integrator): explicit, semi-implicit, implicit, newmark, ...
     double dt = 0;
