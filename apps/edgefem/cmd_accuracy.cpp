@@ -1,7 +1,7 @@
 // `edgefem accuracy`: run time against error on standard dynamic scenes.
 //
-// Scenes (no damping but in the two damped ones, so energy drift is
-// purely numerical):
+// Scenes (no damping but in the three damped ones, so energy drift is
+// purely numerical there):
 //  cantilever  box 12x3x3 (0.12 m, 648 tets), Y = 2e5, nu = 0.35, clamped at
 //              x = min, released from rest under gravity -z;
 //  twist       box 10x2x2 (0.1 m, 240 tets), Y = 1e5, nu = 0.3, clamped at
