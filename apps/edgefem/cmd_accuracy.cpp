@@ -395,7 +395,7 @@ std::vector<Config> scene_configs(const AccScene& sc, bool quick) {
     std::vector<Config> cs;
     auto add = [&](Config c) { cs.push_back(c); };
     // Explicit near and below its stability limit.
-    for (double dt : std::vector<double>{5e-5, 1e-4, 2e-4}) {
+    for (double dt : {5e-5, 1e-4, 2e-4}) {
         if (quick && dt != 1e-4) continue;
         Config c;
         c.integrator = Integrator::Explicit;

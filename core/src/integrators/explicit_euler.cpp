@@ -17,7 +17,7 @@ template <class S>
 class ExplicitEuler final : public TimeIntegrator<S> {
 public:
     explicit ExplicitEuler(SimState<S>& state)
-        : s_(state), kv_(state.template vector<S>(0)), kv_double_(state.template vector<double>(0)) {}
+        : s_(state), v_(state.template vector<double>(0)), kv_(state.template vector<double>(0)) {}
     bool builds_stiffness() const override { return s_.scene.rayleigh_beta > 0; }
 
     std::optional<double> step(double T) override {
@@ -39,20 +39,15 @@ private:
         const auto t0 = Clock::now();
         s_.op->build_stiffness(s_.scene.solver.definite_stiffness);
         s_.stats.stiffness_ms += ms_since(t0);
-        kv_double_.resize(n);
-        if constexpr (std::is_same_v<S, double>) {
-            s_.op->multiply(s_.v.data(), kv_double_.data());
-        } else {
-            kv_.resize(n);
-            s_.op->multiply(s_.v.data(), kv_.data());
-            s_.kernels.from_state(kv_double_.data(), kv_.data(), n);
-        }
-        s_.kernels.axpby(s_.h.data(), -s_.scene.rayleigh_beta, kv_double_.data(), 1.0, n);
+        v_.resize(n);
+        kv_.resize(n);
+        s_.kernels.from_state(v_.data(), s_.v.data(), n);
+        s_.multiply(*s_.op, v_.data(), kv_.data());
+        s_.kernels.axpby(s_.h.data(), -s_.scene.rayleigh_beta, kv_.data(), 1.0, n);
     }
 
     SimState<S>& s_;
-    BackendVector<S> kv_;              // K v (float state)
-    BackendVector<double> kv_double_;  // K v
+    BackendVector<double> v_, kv_;  // v and K v
 };
 
 }  // namespace

@@ -33,7 +33,7 @@ const double* ImplicitStep<S>::damping_product() {
     R_.resize(n);
     work_.resize(n);
     s_.kernels.from_state(R_.data(), s_.v.data(), n);
-    solve_.system().multiply(*op_damp_, R_.data(), work_.data());
+    s_.multiply(*op_damp_, R_.data(), work_.data());
     return work_.data();
 }
 
@@ -66,7 +66,7 @@ void ImplicitStep<S>::linear_solve(double c_i, double c_d) {
     work_.resize(n);
     BackendVector<double> K0d = s_.template vector<double>(n);  // read (as zeros) when c_b = 0
     k.newton_increment(work_.data(), s_.u.data(), ud.data(), n);
-    if (c_b != 0) solve_.system().multiply(*op_damp_, work_.data(), K0d.data());
+    if (c_b != 0) s_.multiply(*op_damp_, work_.data(), K0d.data());
     k.newton_residual({R_.data(), inertia_.data(), s_.f.data(), s_.u.data(), s_.h.data(), s_.mass.data(),
                        upred.data(), work_.data(), K0d.data(), s_.free_dof.data(), true, c_i, c_d,
                        scene.rayleigh_alpha, c_b},

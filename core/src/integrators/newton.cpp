@@ -37,7 +37,7 @@ void Newton<S>::solve(const Inertia* scheme, const ElasticOperator<S>* K0) {
         mag = std::abs(W);
         d_.resize(n);
         k.newton_increment(d_.data(), u, dynamic ? u0 : nullptr, n);
-        if (c_b != 0) solve_.system().multiply(*K0, d_.data(), K0d.data());
+        if (c_b != 0) s_.multiply(*K0, d_.data(), K0d.data());
         // R and the inertia terms, and the sums of h.u, |h u|, the kinetic
         // terms and their sizes.
         const std::array<double, 4> sums =

@@ -65,15 +65,7 @@ double EnergyGuard<S>::damping_drag(double T) {
     k.fill(v_con_.data(), n, 0.0);
     k.velocity_change(v_free_.data(), v_con_.data(), s_.v.data(), s_.free_dof.data(), n);  // v_f; v_con_ = v
     k.axpby(v_con_.data(), -1.0, v_free_.data(), 1.0, n);                                  // v_c
-    if constexpr (std::is_same_v<S, double>) {
-        s_.op->multiply(v_con_.data(), kv_.data());
-    } else {
-        in_.resize(n);
-        out_.resize(n);
-        k.to_state(in_.data(), v_con_.data(), n);
-        s_.op->multiply(in_.data(), out_.data());
-        k.from_state(kv_.data(), out_.data(), n);
-    }
+    s_.multiply(*s_.op, v_con_.data(), kv_.data());
     return -T * s_.scene.rayleigh_beta * k.scaled_dot(v_free_.data(), kv_.data(), n).value();
 }
 

@@ -33,8 +33,7 @@ class EnergyGuard {
 public:
     explicit EnergyGuard(SimState<S>& state)
         : s_(state), u_evaluated_(state.template vector<S>(0)), v_free_(state.template vector<double>(0)),
-          v_con_(state.template vector<double>(0)), kv_(state.template vector<double>(0)),
-          in_(state.template vector<S>(0)), out_(state.template vector<S>(0)) {}
+          v_con_(state.template vector<double>(0)), kv_(state.template vector<double>(0)) {}
     bool enabled() const { return s_.scene.solver.max_energy_growth > 0; }
 
     // The state at the start of a step. The elastic energy comes from the
@@ -87,7 +86,6 @@ private:
     double energy_excess_ = 0;  // energy gained net of work since its lowest level (>= 0)
     double energy_scale_ = 0;   // largest kinetic + elastic energy seen
     BackendVector<double> v_free_, v_con_, kv_;  // damping_drag's work (3 #V when used)
-    BackendVector<S> in_, out_;                   // and its float products
 };
 
 extern template class EnergyGuard<double>;

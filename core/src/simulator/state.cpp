@@ -136,6 +136,19 @@ void SimState<S>::build_damping_tangent(std::unique_ptr<ElasticOperator<S>>& op_
 }
 
 template <class S>
+void SimState<S>::multiply(const ElasticOperator<S>& op, const double* in, double* out) {
+    if constexpr (std::is_same_v<S, double>) {
+        op.multiply(in, out);
+    } else {
+        if (product_in.size() != n()) product_in = vector<S>(n());
+        if (product_out.size() != n()) product_out = vector<S>(n());
+        kernels.to_state(product_in.data(), in, n());
+        op.multiply(product_in.data(), product_out.data());
+        kernels.from_state(out, product_out.data(), n());
+    }
+}
+
+template <class S>
 void SimState<S>::save(CheckpointWriter& w) const {
     w.vector(u);
     w.vector(v);

@@ -64,6 +64,7 @@ struct SimState {
     BackendVector<double> b, x;   // the linear solves' right-hand side and solution
     History<S> history;           // the integrator's (integrators/time_integrator.hpp)
     BackendVector<S> damping_u;   // the u of the last damping tangent K0 (build_damping_tangent)
+    BackendVector<S> product_in, product_out;  // multiply()'s copies of its vectors (float models)
     StepStats stats;
     // Called with the relative residual at every Newton iteration when set
     // (solve_static's progress).
@@ -113,6 +114,8 @@ struct SimState {
     // The damping tangent K0 (Rayleigh beta) at u in `op` (made when null),
     // with the scene's definite_stiffness; u kept as damping_u.
     void build_damping_tangent(std::unique_ptr<ElasticOperator<S>>& op);
+    // out = op in with double vectors (a float model's through copies in S).
+    void multiply(const ElasticOperator<S>& op, const double* in, double* out);
 
     // The checkpoint's part of the state (checkpoint_stream.hpp): u, v, the
     // external and the last internal forces, time, step, the ramp's floor and the integrator's

@@ -71,8 +71,8 @@ constexpr double kBuild = 420;        // and per rebuild of its hierarchy (Smoot
 constexpr int kWindow = 8;            // AMG solves its cost is judged over
 constexpr double kMargin = 1.25;      // block-Jacobi's new threshold: this times the AMG's cost per solve
 constexpr int kHold = 8;              // block-Jacobi set-ups after the first going back before AMG may be tried again
-constexpr int kMaxHold = 1 << 24;     // doubled at each going back up to this (a driven Newton run went back 28
-                                      // times in 30 steps: 8 x 2^28 overflowed an int)
+constexpr int kMaxHold = 1 << 24;     // doubled at each going back up to this (a driven 300-step Newton run went
+                                      // back 28 times: 8 x 2^28 overflowed an int)
 constexpr double kTransient = 1.5;    // a stint's cost per solve over its cheapest one's that may be a transient
 
 template <class S>
@@ -168,7 +168,7 @@ public:
         const double per_solve = kMargin * cost / n;
         const int cap = s_.scene.solver.cg_max_iterations * 4 / 5;
         threshold_ = std::max(s_.scene.solver.auto_amg_iterations, int(std::min<double>(cap, std::ceil(per_solve))));
-        hold_ = hold_ == 0 ? kHold : std::min(2 * std::min(hold_, kMaxHold / 2), kMaxHold);
+        hold_ = hold_ == 0 ? kHold : 2 * std::min(hold_, kMaxHold / 2);
         wait_ = hold_;
         if (stint_cost_ < kTransient * floor_ * stint_decades_) floor_ = std::numeric_limits<double>::infinity();
     }

@@ -3,24 +3,11 @@
 namespace edgefem::sim {
 
 template <class S>
-void LinearSystem<S>::multiply(const ElasticOperator<S>& op, const double* in, double* out) {
-    if constexpr (std::is_same_v<S, double>) {
-        op.multiply(in, out);
-    } else {
-        xs_.resize(s_.n());
-        ys_.resize(s_.n());
-        s_.kernels.to_state(xs_.data(), in, s_.n());
-        op.multiply(xs_.data(), ys_.data());
-        s_.kernels.from_state(out, ys_.data(), s_.n());
-    }
-}
-
-template <class S>
 void LinearSystem<S>::products(const double* in, double* out) {
-    multiply(*s_.op, in, out);
+    s_.multiply(*s_.op, in, out);
     if (c_b_ != 0) {
         Ax_.resize(s_.n());
-        multiply(*K0_, in, Ax_.data());
+        s_.multiply(*K0_, in, Ax_.data());
     }
 }
 

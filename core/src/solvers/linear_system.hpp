@@ -13,8 +13,7 @@ template <class S>
 class LinearSystem final : public CgSystem {
 public:
     explicit LinearSystem(SimState<S>& state)
-        : s_(state), Ax_(state.template vector<double>(0)), xs_(state.template vector<S>(0)),
-          ys_(state.template vector<S>(0)) {}
+        : s_(state), Ax_(state.template vector<double>(0)) {}
 
     // `definite`: K was built definite (SolverSettings::definite_stiffness
     // or the retry on negative curvature), recorded for checkpoints.
@@ -32,8 +31,6 @@ public:
     const ElasticOperator<S>& K() const { return *s_.op; }
     const ElasticOperator<S>* K0() const { return K0_; }
 
-    // y = op x with double vectors (converts for float models).
-    void multiply(const ElasticOperator<S>& op, const double* in, double* out);
     // out = K in, and K0 in kept for finish().
     void products(const double* in, double* out) override;
     // out = c_m M in + c_k out (+ c_b K0 in) on [lo, hi), after products().
@@ -47,7 +44,6 @@ private:
     const ElasticOperator<S>* K0_ = nullptr;
     bool definite_ = false;
     BackendVector<double> Ax_;  // K0 x
-    BackendVector<S> xs_, ys_;  // float models: the product's vectors in S
 };
 
 extern template class LinearSystem<double>;
