@@ -38,7 +38,7 @@ check() {
     nvcc --version 2>/dev/null | tail -1
     echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2) x $(nproc)"
     echo "== GPU tests (whole output: $tests_log)"
-    run_prog 200 edgefem_test_cuda_backend 2>&1 | tee "$tests_log" | grep -E "^\[ *(RUN|OK|FAILED|PASSED|SKIPPED) |Failure|error|beam, 1000|Expected|Which is|actual"
+    run_prog 300 edgefem_test_cuda_backend 2>&1 | tee "$tests_log" | grep -E "^\[ *(RUN|OK|FAILED|PASSED|SKIPPED) |Failure|error|beam, 1000|against CPU|Expected|Which is|actual"
     echo "tests rc=${PIPESTATUS[0]}"
     echo "== GPU benchmarks"
     run_prog 100 edgefem_bench_gpu --meshes armadillo-7k,bunny-250k,bunny-1m 2>&1

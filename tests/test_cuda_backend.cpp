@@ -6,13 +6,17 @@
 // largest entry, on generated boxes and every shared mesh present (bunny-1m
 // included); two runs bitwise the same; whole simulations (semi-implicit,
 // implicit, explicit, a static solve) within 1e-9 of the CPU back-end's with
-// the same CG iteration counts, for each gather form of K x, and 1000
-// semi-implicit steps of the built-in beam too. Without a GPU (or a build without CUDA) every test but
-// the first is skipped with the reason, and the first checks that asking
-// for the back-end then fails with that reason.
+// the same CG iteration counts, for each gather form of K x; every
+// integrator with damping and a prescribed vertex, double and float; 1000
+// semi-implicit steps of the built-in beam (CG to 1e-10) within 1e-12.
+// Without a GPU (or a build without CUDA) every test but the first is
+// skipped with the reason, and the first checks that asking for the
+// back-end then fails with that reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -152,18 +156,79 @@ TEST(CudaBackend, SimulationsMatchTheCpuBackend) {
     }
 }
 
+// Every integrator (docs/dynamics.md) on the GPU: Rayleigh alpha and beta
+// (beta too in the explicit symplectic Euler, which builds K for it; not in
+// Verlet, which rejects it), fixed vertices and a prescribed one, double
+// within 1e-9 of the CPU back-end, two GPU runs bitwise the same, and float
+// on the GPU within 1e-4 of the largest displacement of the double CPU run
+// (the CPU's float runs: 3e-8 to 2e-6).
+TEST(CudaBackend, EveryIntegratorMatchesTheCpuBackend) {
+    REQUIRE_GPU();
+    const auto dev = make_cuda_backend<double>();
+    const auto devf = make_cuda_backend<float>();
+    for (const auto& [name, integ] : integrator_names()) {
+        SCOPED_TRACE(name);
+        Scene scene = test::clamped_box_scene(8, 3, 3);
+        scene.integrator = integ;
+        scene.rayleigh_alpha = 0.5;
+        scene.rayleigh_beta = integ == Integrator::Verlet ? 0 : integ == Integrator::Explicit ? 2e-4 : 1e-3;
+        scene.dt = is_explicit(integ) ? 1e-4 : 5e-3;
+        const index_t v = scene.mesh.num_vertices() - 1;
+        scene.prescribed.push_back({v, {scene.mesh.X[3 * v] + 0.005, scene.mesh.X[3 * v + 1], scene.mesh.X[3 * v + 2]}});
+        scene.prescribed_steps = is_explicit(integ) ? 20 : 2;
+        scene.solver.cg_tolerance = 1e-11;
+        scene.solver.cg_max_iterations = 3000;
+        scene.solver.preconditioner = PreconditionerKind::BlockJacobi;  // as the GPU runs it
+        const int steps = is_explicit(integ) ? 40 : 4;
+        Simulator<double> cpu(scene, make_cpu_backend<double>()), gpu(scene, dev), gpu2(scene, dev);
+        Scene scene_f = scene;
+        scene_f.solver.cg_tolerance = 1e-6;
+        Simulator<float> gpuf(scene_f, devf);
+        for (int k = 0; k < steps; ++k) {
+            cpu.step();
+            gpu.step();
+            gpu2.step();
+            gpuf.step();
+        }
+        EXPECT_LE(rel_diff(gpu.positions(), cpu.positions()), 1e-9);
+        EXPECT_TRUE(bitwise_equal(gpu.positions(), gpu2.positions())) << "two GPU runs differ";
+        double diff = 0, ref = 0;
+        for (std::size_t i = 0; i < cpu.displacement().size(); ++i) {
+            diff = std::max(diff, std::abs(double(gpuf.displacement()[i]) - cpu.displacement()[i]));
+            ref = std::max(ref, std::abs(cpu.displacement()[i]));
+        }
+        EXPECT_GT(ref, 0);
+        EXPECT_LE(diff, 1e-4 * ref) << "float on the GPU";
+        std::printf("%s: GPU against CPU %.3g, float GPU against double CPU %.3g of the largest displacement\n",
+                    name, rel_diff(gpu.positions(), cpu.positions()), diff / ref);
+    }
+}
+
+// The built-in beam, 1000 semi-implicit steps, with CG to 1e-10. At the
+// scene's 1e-6 a round-off difference can decide whether a solve stops one
+// iteration earlier, and the trajectories then part at the tolerance's
+// scale: the GPU 1.1e-9 (of the positions) from the CPU by step 1000 (H200,
+// 2026-11-28), as the reference back-end does from the CPU back-end (3.7e-9
+// of the largest displacement, from step 800). At 1e-10 those two stay
+// within 2e-15 of it, with the same iterations.
 TEST(CudaBackend, BeamThousandStepsMatchTheCpuTrajectory) {
     REQUIRE_GPU();
     Scene scene = default_scene();
     scene.steps = 1000;
+    scene.solver.cg_tolerance = 1e-10;
     scene.solver.preconditioner = PreconditionerKind::BlockJacobi;  // as the GPU runs it (see above)
     Simulator<double> cpu(scene, make_cpu_backend<double>()), gpu(scene, make_cuda_backend<double>());
     double worst = 0;
     for (int k = 0; k < scene.steps; ++k) {
         cpu.step();
         gpu.step();
-        if (k % 100 == 99) worst = std::max(worst, rel_diff(gpu.positions(), cpu.positions()));
+        if (k % 100 == 99) {
+            const std::vector<double> a(gpu.displacement().begin(), gpu.displacement().end()),
+                b(cpu.displacement().begin(), cpu.displacement().end());
+            worst = std::max(worst, rel_diff(a, b));
+        }
     }
-    EXPECT_LE(worst, 1e-9);
-    std::printf("beam, 1000 semi-implicit steps: GPU against CPU, worst relative difference %.3g\n", worst);
+    EXPECT_LE(worst, 1e-12);
+    std::printf("beam, 1000 semi-implicit steps: GPU against CPU, worst difference %.3g of the largest displacement\n",
+                worst);
 }
