@@ -72,6 +72,7 @@ TEST(SceneJson, Defaults) {
     EXPECT_EQ(s.solver.load_steps, d.solver.load_steps);
     EXPECT_EQ(s.solver.max_step_halvings, d.solver.max_step_halvings);
     EXPECT_EQ(s.solver.stiffness_interval, 1);
+    EXPECT_TRUE(s.solver.warm_start);
     EXPECT_EQ(s.solver.max_energy_growth, d.solver.max_energy_growth);
     EXPECT_EQ(s.solver.max_energy_growth, 10);  // the documented default
     EXPECT_EQ(sf.output.dir, "edgefem-out");
@@ -110,7 +111,7 @@ TEST(SceneJson, EveryKey) {
         "solver": {"linear": "direct", "cg_tolerance": 1e-8, "cg_max_iterations": 77, "cg_fixed_iterations": 0,
                    "definite_stiffness": true, "newton_tolerance": 1e-9, "newton_max_iterations": 12,
                    "load_steps": 3, "max_step_halvings": 2, "stiffness_interval": 1,
-                   "fail_on_unconverged": false, "max_energy_growth": 3},
+                   "fail_on_unconverged": false, "max_energy_growth": 3, "warm_start": false},
         "output": {"dir": "out/here", "every": 4, "vtu": false, "format": "obj", "mesh": "surface",
                    "fields": ["green_strain", "pk2_stress"]}
     })",
@@ -151,6 +152,7 @@ TEST(SceneJson, EveryKey) {
     EXPECT_EQ(s.solver.stiffness_interval, 1);
     EXPECT_FALSE(s.solver.fail_on_unconverged);
     EXPECT_EQ(s.solver.max_energy_growth, 3);
+    EXPECT_FALSE(s.solver.warm_start);
     EXPECT_EQ(sf.output.dir, "out/here");
     EXPECT_EQ(sf.output.every, 4);
     EXPECT_FALSE(sf.output.vtu);

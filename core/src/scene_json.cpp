@@ -443,7 +443,7 @@ Material read_material(const Context& cx, const json& v, const std::string& path
 void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     const std::string p = "solver";
     check_keys(cx, v, p,
-               {"linear", "preconditioner", "auto_amg_iterations", "amg_refresh_interval", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "definite_stiffness",
+               {"linear", "preconditioner", "auto_amg_iterations", "amg_refresh_interval", "cg_tolerance", "cg_max_iterations", "cg_fixed_iterations", "warm_start", "definite_stiffness",
                 "newton_tolerance", "newton_max_iterations", "load_steps", "max_step_halvings",
                 "stiffness_interval", "fail_on_unconverged", "max_energy_growth", "fail_on_inverted"});
     if (const json* x = find(v, "fail_on_inverted")) s.fail_on_inverted = get_bool(cx, *x, join(p, "fail_on_inverted"));
@@ -461,6 +461,7 @@ void read_solver(const Context& cx, const json& v, SolverSettings& s) {
     if (const json* x = find(v, "cg_tolerance")) s.cg_tolerance = get_number(cx, *x, join(p, "cg_tolerance"), Range::Positive);
     if (const json* x = find(v, "cg_max_iterations")) s.cg_max_iterations = get_int(cx, *x, join(p, "cg_max_iterations"), 1);
     if (const json* x = find(v, "cg_fixed_iterations")) s.cg_fixed_iterations = get_int(cx, *x, join(p, "cg_fixed_iterations"), 0);
+    if (const json* x = find(v, "warm_start")) s.warm_start = get_bool(cx, *x, join(p, "warm_start"));
     if (const json* x = find(v, "definite_stiffness")) s.definite_stiffness = get_bool(cx, *x, join(p, "definite_stiffness"));
     if (const json* x = find(v, "fail_on_unconverged")) s.fail_on_unconverged = get_bool(cx, *x, join(p, "fail_on_unconverged"));
     if (const json* x = find(v, "newton_tolerance")) s.newton_tolerance = get_number(cx, *x, join(p, "newton_tolerance"), Range::Positive);

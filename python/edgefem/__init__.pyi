@@ -131,6 +131,7 @@ class Material:
 class SolverSettings:
     linear_solver: LinearSolver
     cg_tolerance: float
+    warm_start: bool
     cg_max_iterations: int
     cg_fixed_iterations: int
     definite_stiffness: bool

@@ -455,6 +455,7 @@ PYBIND11_MODULE(_edgefem, m) {
         .def_readwrite("auto_amg_iterations", &SolverSettings::auto_amg_iterations)
         .def_readwrite("amg_refresh_interval", &SolverSettings::amg_refresh_interval)
         .def_readwrite("cg_tolerance", &SolverSettings::cg_tolerance)
+        .def_readwrite("warm_start", &SolverSettings::warm_start)
         .def_readwrite("cg_max_iterations", &SolverSettings::cg_max_iterations)
         .def_readwrite("cg_fixed_iterations", &SolverSettings::cg_fixed_iterations)
         .def_readwrite("definite_stiffness", &SolverSettings::definite_stiffness)

@@ -184,6 +184,10 @@ def test_energy_guard_setting_and_stats():
     # and lets a normal semi-implicit run through while reporting its ratio.
     scene = clamped_box_scene(4, 2, 2)
     assert scene.solver.max_energy_growth == 10 and scene.solver.fail_on_unconverged
+    assert scene.solver.warm_start is True
+    scene.solver.warm_start = False
+    assert scene.solver.warm_start is False
+    scene.solver.warm_start = True
     scene.integrator = edgefem.Integrator.Explicit
     scene.material = edgefem.Material(1e9, 0.3, 1000)
     scene.dt = 1e-2

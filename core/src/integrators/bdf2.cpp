@@ -38,9 +38,19 @@ public:
             s_.kernels.history_predict(step_.upred.data(), step_.ud.data(), s_.u.data(), s_.v.data(), nullptr,
                                        nullptr, {1, T, 0, 0}, {1, 0, 0, 0}, n);
         }
+        // The correction u' - upred is T^2 a' / a0^2 (a' the BDF2
+        // acceleration); the linearised solve starts from upred improved
+        // along the last step's change of velocity v - v_1, the shape of a.
+        const double* direction = nullptr;
         s_.kernels.from_state(u1, s_.u.data(), n);
-        s_.kernels.from_state(v1, s_.v.data(), n);
-        const std::optional<double> W = step_.solve(c_i, c_d);
+        if (bdf2 && step_.warm()) {
+            step_.direction.resize(n);
+            s_.kernels.velocity_change(step_.direction.data(), v1, s_.v.data(), s_.free_dof.data(), n);
+            direction = step_.direction.data();
+        } else {
+            s_.kernels.from_state(v1, s_.v.data(), n);
+        }
+        const std::optional<double> W = step_.solve(c_i, c_d, direction);
         step_.finish(c_d, nullptr, 0);
         s_.history_done(T);
         return W;

@@ -9,7 +9,8 @@ namespace edgefem::sim {
 
 template <class S>
 ImplicitStep<S>::ImplicitStep(SimState<S>& state, TangentSolve<S>& solve, bool linear)
-    : upred(state.template vector<double>(state.n())), ud(state.template vector<double>(state.n())), s_(state),
+    : upred(state.template vector<double>(state.n())), ud(state.template vector<double>(state.n())),
+      direction(state.template vector<double>(0)), s_(state),
       solve_(solve), newton_(state, solve), linear_(linear), u0_(state.template vector<double>(state.n())),
       cvel_(state.template vector<double>(state.n())), work_(state.template vector<double>(0)),
       R_(state.template vector<double>(0)), inertia_(state.template vector<double>(0)) {}
@@ -38,10 +39,16 @@ const double* ImplicitStep<S>::damping_product() {
 }
 
 template <class S>
-std::optional<double> ImplicitStep<S>::solve(double c_i, double c_d) {
+bool ImplicitStep<S>::warm() const {
+    const SolverSettings& sv = s_.scene.solver;
+    return linear_ && sv.warm_start && sv.cg_fixed_iterations == 0 && sv.linear_solver == LinearSolver::CG;
+}
+
+template <class S>
+std::optional<double> ImplicitStep<S>::solve(double c_i, double c_d, const double* direction) {
     const double s = s_.ramp(s_.time + T_);
     if (linear_) {
-        linear_solve(c_i, c_d);
+        linear_solve(c_i, c_d, direction);
         return std::nullopt;
     }
     // Newton from the prediction with the constrained dofs at their targets.
@@ -54,9 +61,10 @@ std::optional<double> ImplicitStep<S>::solve(double c_i, double c_d) {
 
 // One Newton iteration from the step's start, where f is (start_forces):
 // (c_m M + K + c_b K0) du = -R(u0), du = the prediction's as the warm start
-// and the targets' on constrained dofs; u' = u0 + du.
+// (improved along the scheme's direction) and the targets' on constrained
+// dofs; u' = u0 + du. K0 is K here.
 template <class S>
-void ImplicitStep<S>::linear_solve(double c_i, double c_d) {
+void ImplicitStep<S>::linear_solve(double c_i, double c_d, const double* direction) {
     const Scene& scene = s_.scene;
     const VectorKernels<S>& k = s_.kernels;
     const std::size_t n = s_.n();
@@ -77,8 +85,12 @@ void ImplicitStep<S>::linear_solve(double c_i, double c_d) {
     s_.hold_constraints(s_.ramp(s_.time + T_));
     k.newton_increment(s_.x.data(), s_.u.data(), u0_.data(), n);
     k.to_state(s_.u.data(), u0_.data(), n);
-    const CgResult res = solve_.solve(c_m, 1.0, c_b, op_damp_.get(), scene.solver.cg_tolerance,
-                                      scene.solver.definite_stiffness, false, scene.solver.cg_fixed_iterations);
+    // K is built at the step's start, as K0 is, and clamped alike: A = c_m M
+    // + (1 + c_b) K, one product per CG iteration instead of two. (After
+    // negative curvature the retry's definite K is the damping's too.)
+    const CgResult res = solve_.solve(c_m, 1.0 + c_b, 0.0, nullptr, scene.solver.cg_tolerance,
+                                      scene.solver.definite_stiffness, false, scene.solver.cg_fixed_iterations,
+                                      direction);
     check_linear_solve(s_, res);
     k.line_search_point(s_.u.data(), u0_.data(), s_.x.data(), 1.0, n);
 }

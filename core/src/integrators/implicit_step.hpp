@@ -25,16 +25,24 @@ public:
     void begin(double T);
     // K0 v at the step's start when beta > 0, else null (after begin).
     const double* damping_product();
+    // Whether a linearised solve improves its start along a direction (CG
+    // to its tolerance: not Newton, not a fixed CG budget, not the direct
+    // solver).
+    bool warm() const;
     // Solves for u' (the state's u) with the scheme's upred and ud; the
     // elastic energy at u' when it was evaluated there (Newton).
-    std::optional<double> solve(double c_i, double c_d);
+    // `direction` (zero on constrained dofs; may be null): the linearised
+    // solve's start upred is improved along it (SystemSolver::solve), a
+    // scheme's estimate of the shape of u' - upred.
+    std::optional<double> solve(double c_i, double c_d, const double* direction = nullptr);
     // v' = c_v (u' - ud), and a' = c_a (u' - upred) when a is not null.
     void finish(double c_v, double* a, double c_a);
 
     BackendVector<double> upred, ud;  // the scheme's predictions (3 #V)
+    BackendVector<double> direction;  // for the scheme's direction, sized by it
 
 private:
-    void linear_solve(double c_i, double c_d);
+    void linear_solve(double c_i, double c_d, const double* direction);
 
     SimState<S>& s_;
     TangentSolve<S>& solve_;

@@ -59,7 +59,16 @@ public:
         s_.kernels.history_predict(step_.upred.data(), step_.ud.data(), s_.u.data(), s_.v.data(), a, nullptr,
                                    {1, T, pa, 0}, {1, T - 1 / c_d, pa - T * (1 - gamma) / c_d, 0}, n);
         if (am != 0 || af != 0) load(s_.h.data(), 1, af / (1 - af), -am / (1 - af), false);
-        const std::optional<double> W = step_.solve(c_i, c_d);
+        // The correction u' - upred is beta T^2 a', and a' is near a (the
+        // last step's, or the balance's at u, v): the linearised solve
+        // starts from upred improved along a.
+        const double* direction = nullptr;
+        if (step_.warm()) {
+            step_.direction.resize(n);
+            s_.kernels.free_part(step_.direction.data(), a, s_.free_dof.data(), n);
+            direction = step_.direction.data();
+        }
+        const std::optional<double> W = step_.solve(c_i, c_d, direction);
         step_.finish(c_d, a, 1 / (beta * T * T));
         s_.history_done(T);
         return W;

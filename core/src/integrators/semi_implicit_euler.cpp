@@ -30,7 +30,8 @@ public:
         // after a state the application wrote, nor after a checkpoint
         // without it). Not with a fixed CG budget (its iterations' cost is
         // the budget) or the direct solver.
-        const bool warm = scene.solver.cg_fixed_iterations == 0 && scene.solver.linear_solver == LinearSolver::CG;
+        const bool warm = scene.solver.warm_start && scene.solver.cg_fixed_iterations == 0 &&
+                          scene.solver.linear_solver == LinearSolver::CG;
         const double* direction = nullptr;
         if (warm) {
             const bool current = s_.history_current();

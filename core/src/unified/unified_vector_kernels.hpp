@@ -85,6 +85,9 @@ public:
             v_prev[i] = now;
         });
     }
+    void free_part(double* d, const double* x, const std::uint8_t* free_dof, std::size_t n) const override {
+        launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { d[i] = free_dof[i] ? x[i] : 0.0; });
+    }
     void axpby(double* y, double a, const double* x, double c, std::size_t n) const override {
         launch_.each(n, [=] EDGEFEM_LAMBDA(std::size_t i) { y[i] = a * x[i] + c * y[i]; });
     }

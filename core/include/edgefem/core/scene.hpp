@@ -82,6 +82,12 @@ struct SolverSettings {
     double cg_tolerance = 1e-6;   // relative residual |r| / |b| of the projected system
     int cg_max_iterations = 500;
     int cg_fixed_iterations = 0;  // > 0: exactly this many warm-started iterations (haptic budget)
+    // The linearised steps' CG to a tolerance starts from the step's
+    // prediction improved along a direction from the history (semi-implicit
+    // and BDF2: the last change of velocity; Newmark, generalized-alpha: the
+    // acceleration), by the amount that lowers the error most; false: from
+    // the prediction.
+    bool warm_start = true;
     bool definite_stiffness = false;  // clamp g(E) at zero inside K (edge method)
     double newton_tolerance = 1e-10;  // relative residual for Implicit and static solves
     int newton_max_iterations = 50;

@@ -100,10 +100,13 @@ public:
                                    const double* mass, double T, std::size_t n) const = 0;
     // v = x, u += T x.
     virtual void take_velocity(S* u, S* v, const double* x, double T, std::size_t n) const = 0;
-    // The semi-implicit step's warm-start direction: d = v - v_prev on free
-    // dofs, 0 on constrained ones; then v_prev = v.
+    // The semi-implicit and BDF2 steps' warm-start direction: d = v - v_prev
+    // on free dofs, 0 on constrained ones; then v_prev = v.
     virtual void velocity_change(double* d, double* v_prev, const S* v, const std::uint8_t* free_dof,
                                  std::size_t n) const = 0;
+    // The linearised Newmark step's warm-start direction: d = x on free
+    // dofs, 0 on constrained ones.
+    virtual void free_part(double* d, const double* x, const std::uint8_t* free_dof, std::size_t n) const = 0;
     // y = a x + c y.
     virtual void axpby(double* y, double a, const double* x, double c, std::size_t n) const = 0;
     // {d.b, x.Ad, d.Ad}: a warm start's improvement along d (plain sums,
