@@ -364,6 +364,27 @@ TEST(Simulator, StiffnessIntervalReusesKAndStaysClose) {
     EXPECT_THROW(Simulator<double>{lagged}, InvalidArgument);
 }
 
+// With stiffness damping a linearised step's damping tangent K0 is its K
+// (both at the step's start): one K built per step, for every linearised
+// integrator (a second operator built K0 as well until 2026-11-28). The
+// Newton forms build K0 and a K per Newton iteration.
+TEST(Simulator, LinearisedStepsWithStiffnessDampingBuildOneK) {
+    for (Integrator integ : {Integrator::SemiImplicit, Integrator::NewmarkLinear, Integrator::GeneralizedAlphaLinear,
+                             Integrator::Bdf2Linear, Integrator::Newmark}) {
+        SCOPED_TRACE(to_string(integ));
+        Scene s = cantilever(integ, 2e-3);
+        s.rayleigh_beta = 1e-3;
+        int builds = 0;
+        Simulator<double> sim(s, nullptr, counting_factory(builds));
+        long newton_iterations = 0;
+        for (int k = 0; k < 10; ++k) newton_iterations += sim.step().newton_iterations;
+        if (integ == Integrator::Newmark)
+            EXPECT_EQ(builds, 10 + newton_iterations);
+        else
+            EXPECT_EQ(builds, 10);
+    }
+}
+
 // A CG solve cut off by its iteration cap is never silent: an error naming
 // the step (the default), or counted in the step's statistics when the scene
 // opts out.

@@ -24,17 +24,25 @@ void ImplicitStep<S>::begin(double T) {
     s_.external(1.0);
     s_.kernels.from_state(u0_.data(), s_.u.data(), n);
     s_.constrained_velocities(T, s_.time + T, cvel_.data());
-    if (scene.rayleigh_beta > 0) s_.build_damping_tangent(op_damp_);
+    damping_ = nullptr;
+    if (scene.rayleigh_beta <= 0) return;
+    if (linear_) {  // the step's K is K0: built once, here, and solved with
+        solve_.build_stiffness(scene.solver.definite_stiffness);
+        damping_ = s_.op.get();
+    } else {
+        s_.build_damping_tangent(op_damp_);
+        damping_ = op_damp_.get();
+    }
 }
 
 template <class S>
 const double* ImplicitStep<S>::damping_product() {
-    if (!op_damp_) return nullptr;
+    if (!damping_) return nullptr;
     const std::size_t n = s_.n();
     R_.resize(n);
     work_.resize(n);
     s_.kernels.from_state(R_.data(), s_.v.data(), n);
-    s_.multiply(*op_damp_, R_.data(), work_.data());
+    s_.multiply(*damping_, R_.data(), work_.data());
     return work_.data();
 }
 
@@ -55,7 +63,7 @@ std::optional<double> ImplicitStep<S>::solve(double c_i, double c_d, const doubl
     s_.kernels.to_state(s_.u.data(), upred.data(), s_.n());
     s_.hold_constraints(s);
     const Inertia inertia{c_i, c_d, ud.data(), upred.data()};
-    newton_.solve(&inertia, op_damp_.get());
+    newton_.solve(&inertia, damping_);
     return newton_.energy();  // Newton's last evaluation was at the new u
 }
 
@@ -74,7 +82,7 @@ void ImplicitStep<S>::linear_solve(double c_i, double c_d, const double* directi
     work_.resize(n);
     BackendVector<double> K0d = s_.template vector<double>(n);  // read (as zeros) when c_b = 0
     k.newton_increment(work_.data(), s_.u.data(), ud.data(), n);
-    if (c_b != 0) s_.multiply(*op_damp_, work_.data(), K0d.data());
+    if (c_b != 0) s_.multiply(*damping_, work_.data(), K0d.data());
     k.newton_residual({R_.data(), inertia_.data(), s_.f.data(), s_.u.data(), s_.h.data(), s_.mass.data(),
                        upred.data(), work_.data(), K0d.data(), s_.free_dof.data(), true, c_i, c_d,
                        scene.rayleigh_alpha, c_b},
@@ -85,12 +93,12 @@ void ImplicitStep<S>::linear_solve(double c_i, double c_d, const double* directi
     s_.hold_constraints(s_.ramp(s_.time + T_));
     k.newton_increment(s_.x.data(), s_.u.data(), u0_.data(), n);
     k.to_state(s_.u.data(), u0_.data(), n);
-    // K is built at the step's start, as K0 is, and clamped alike: A = c_m M
-    // + (1 + c_b) K, one product per CG iteration instead of two. (After
-    // negative curvature the retry's definite K is the damping's too.)
+    // K0 is K (begin() built it): A = c_m M + (1 + c_b) K, one product per
+    // CG iteration. (After negative curvature the retry's definite K is the
+    // damping's too.)
     const CgResult res = solve_.solve(c_m, 1.0 + c_b, 0.0, nullptr, scene.solver.cg_tolerance,
-                                      scene.solver.definite_stiffness, false, scene.solver.cg_fixed_iterations,
-                                      direction);
+                                      scene.solver.definite_stiffness, damping_ ? Stiffness::Built : Stiffness::Build,
+                                      scene.solver.cg_fixed_iterations, direction);
     check_linear_solve(s_, res);
     k.line_search_point(s_.u.data(), u0_.data(), s_.x.data(), 1.0, n);
 }

@@ -50,7 +50,8 @@ private:
     bool linear_;
     double T_ = 0;
     BackendVector<double> u0_, cvel_, work_, R_, inertia_;
-    std::unique_ptr<ElasticOperator<S>> op_damp_;  // K frozen at the step start (beta > 0)
+    std::unique_ptr<ElasticOperator<S>> op_damp_;  // Newton's K0: K frozen at the step start (beta > 0)
+    const ElasticOperator<S>* damping_ = nullptr;  // K0 (beta > 0): op_damp_, or the state's K when linear
 };
 
 // A linearised step's solve result: counted, and a failure (a non-finite

@@ -48,7 +48,8 @@ public:
         // was built for (a halved step changes the system matrix).
         const bool reuse = stiffness_age_ > 0 && stiffness_age_ < scene.solver.stiffness_interval && T == stiffness_dt_;
         const CgResult res = solve_.solve(c_m, c_k, 0.0, nullptr, scene.solver.cg_tolerance,
-                                          scene.solver.definite_stiffness, reuse, scene.solver.cg_fixed_iterations,
+                                          scene.solver.definite_stiffness, reuse ? Stiffness::Reuse : Stiffness::Build,
+                                          scene.solver.cg_fixed_iterations,
                                           direction);
         stiffness_age_ = reuse ? stiffness_age_ + 1 : 1;
         stiffness_dt_ = T;

@@ -9,27 +9,34 @@ TangentSolve<S>::TangentSolve(SimState<S>& state) : s_(state), system_(state), s
 
 template <class S>
 CgResult TangentSolve<S>::solve(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
-                                bool definite, bool reuse_stiffness, int fixed_iterations, const double* direction) {
-    CgResult res = solve_once(c_m, c_k, c_b, K0, tolerance, definite, reuse_stiffness, fixed_iterations, direction);
+                                bool definite, Stiffness stiffness, int fixed_iterations, const double* direction) {
+    CgResult res = solve_once(c_m, c_k, c_b, K0, tolerance, definite, stiffness, fixed_iterations, direction);
     if (res.negative_curvature && !definite && s_.scene.method == Method::Edge) {
         s_.stats.negative_curvature = true;
         const int its = res.iterations;
-        res = solve_once(c_m, c_k, c_b, K0, tolerance, true, false, fixed_iterations, direction);
+        res = solve_once(c_m, c_k, c_b, K0, tolerance, true, Stiffness::Build, fixed_iterations, direction);
         res.iterations += its;
     }
     return res;
 }
 
 template <class S>
+void TangentSolve<S>::build_stiffness(bool definite) {
+    const auto t0 = Clock::now();
+    s_.op->build_stiffness(definite);
+    s_.stats.stiffness_ms += ms_since(t0);
+}
+
+template <class S>
 CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0,
-                                     double tolerance, bool definite, bool reuse_stiffness, int fixed_iterations,
+                                     double tolerance, bool definite, Stiffness stiffness, int fixed_iterations,
                                      const double* direction) {
     auto t0 = Clock::now();
     const int refreshes = solver_->refreshes();
-    reuse_stiffness = reuse_stiffness && solver_->reusable();
+    const bool reuse = stiffness == Stiffness::Reuse && solver_->reusable();
     system_.set(c_m, c_k, c_b, K0, definite);
-    if (!reuse_stiffness) {
-        s_.op->build_stiffness(definite);
+    if (!reuse) {
+        if (stiffness != Stiffness::Built) s_.op->build_stiffness(definite);
         if (s_.scene.solver.stiffness_interval > 1) lagged_.record(s_, system_);
         const int analyses = solver_->analyses();
         solver_->setup(system_);

@@ -13,6 +13,13 @@
 
 namespace edgefem::sim {
 
+// What a solve does with K: build it at the operator's last forces() state
+// (and set up the solver), take the one built by build_stiffness() since
+// that state (and set up the solver on it), or reuse the K and set-up of
+// an earlier solve where the solver allows (SolverSettings::
+// stiffness_interval).
+enum class Stiffness { Build, Built, Reuse };
+
 template <class S>
 class TangentSolve {
 public:
@@ -21,19 +28,21 @@ public:
     LinearSystem<S>& system() { return system_; }
 
     // A = c_m M + c_k K + c_b K0 (K0: null when c_b = 0).
-    // `reuse_stiffness`: keep the K and set-up of an earlier solve (when
-    // the solver allows; SolverSettings::stiffness_interval).
+    // `stiffness`: see Stiffness (a retry builds the definite K).
     // `fixed_iterations` > 0: exactly that many CG iterations (the
     // semi-implicit step's budget, cg_fixed_iterations; Newton's solves
     // always run to their tolerance: with the budget they failed to
     // converge).
     // `direction`: SystemSolver::solve's (the warm start improved along it).
     CgResult solve(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance, bool definite,
-                   bool reuse_stiffness = false, int fixed_iterations = 0, const double* direction = nullptr);
+                   Stiffness stiffness = Stiffness::Build, int fixed_iterations = 0, const double* direction = nullptr);
     // The same without the retry.
     CgResult solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
-                        bool definite, bool reuse_stiffness = false, int fixed_iterations = 0,
+                        bool definite, Stiffness stiffness = Stiffness::Build, int fixed_iterations = 0,
                         const double* direction = nullptr);
+    // K at the operator's last forces() state, timed as the solves' builds
+    // are, for a step that applies it before its solve (Stiffness::Built).
+    void build_stiffness(bool definite);
 
     // For a checkpoint: the solver's set-up that may outlive a step and the
     // lagged K (stiffness_interval > 1); load() rebuilds them.
