@@ -48,8 +48,7 @@ const double* ImplicitStep<S>::damping_product() {
 
 template <class S>
 bool ImplicitStep<S>::warm() const {
-    const SolverSettings& sv = s_.scene.solver;
-    return linear_ && sv.warm_start && sv.cg_fixed_iterations == 0 && sv.linear_solver == LinearSolver::CG;
+    return linear_ && warm_starts(s_.scene.solver);
 }
 
 template <class S>

@@ -25,9 +25,8 @@ public:
     void begin(double T);
     // K0 v at the step's start when beta > 0, else null (after begin).
     const double* damping_product();
-    // Whether a linearised solve improves its start along a direction (CG
-    // to its tolerance: not Newton, not a fixed CG budget, not the direct
-    // solver).
+    // Whether a linearised solve improves its start along a direction (not
+    // Newton; warm_starts below).
     bool warm() const;
     // Solves for u' (the state's u) with the scheme's upred and ud; the
     // elastic energy at u' when it was evaluated there (Newton).
@@ -53,6 +52,13 @@ private:
     std::unique_ptr<ElasticOperator<S>> op_damp_;  // Newton's K0: K frozen at the step start (beta > 0)
     const ElasticOperator<S>* damping_ = nullptr;  // K0 (beta > 0): op_damp_, or the state's K when linear
 };
+
+// Whether a linearised step's CG improves its start along a direction from
+// the history: SolverSettings::warm_start, and not with a fixed CG budget
+// (its iterations' cost is the budget) or the direct solver.
+inline bool warm_starts(const SolverSettings& sv) {
+    return sv.warm_start && sv.cg_fixed_iterations == 0 && sv.linear_solver == LinearSolver::CG;
+}
 
 // A linearised step's solve result: counted, and a failure (a non-finite
 // residual; CG above its tolerance without a fixed budget when

@@ -28,10 +28,8 @@ public:
         s_.constrained_velocities(T, s_.time + T, s_.x.data());
         // The history's v_prev, where it belongs to this u and v (not
         // after a state the application wrote, nor after a checkpoint
-        // without it). Not with a fixed CG budget (its iterations' cost is
-        // the budget) or the direct solver.
-        const bool warm = scene.solver.warm_start && scene.solver.cg_fixed_iterations == 0 &&
-                          scene.solver.linear_solver == LinearSolver::CG;
+        // without it), where warm_starts allows.
+        const bool warm = warm_starts(scene.solver);
         const double* direction = nullptr;
         if (warm) {
             const bool current = s_.history_current();
