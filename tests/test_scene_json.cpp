@@ -359,6 +359,7 @@ TEST(SceneJsonErrors, WrongTypes) {
     expect_error(scene(R"("gravity": [0, 0])"), {"\"gravity\"", "3 numbers"});
     expect_error(scene(R"("gravity": [0, "a", 0])"), {"\"gravity[1]\""});
     expect_error(scene(R"("solver": {"definite_stiffness": 1})"), {"\"solver.definite_stiffness\"", "true or false"});
+    expect_error(scene(R"("solver": {"warm_start": "no"})"), {"\"solver.warm_start\"", "true or false"});
     expect_error(scene(R"("solver": {"cg_max_iterations": 0})"), {"\"solver.cg_max_iterations\"", "positive integer"});
     expect_error(scene(R"("solver": 3)"), {"\"solver\"", "object"});
     expect_error(scene(R"("output": {"every": 0})"), {"\"output.every\""});

@@ -187,6 +187,8 @@ def test_energy_guard_setting_and_stats():
     assert scene.solver.warm_start is True
     scene.solver.warm_start = False
     assert scene.solver.warm_start is False
+    with pytest.raises(TypeError):
+        scene.solver.warm_start = "no"
     scene.solver.warm_start = True
     scene.integrator = edgefem.Integrator.Explicit
     scene.material = edgefem.Material(1e9, 0.3, 1000)
