@@ -24,8 +24,8 @@
 //  * the linearised bar's vibration modes (K at rest, the lumped M, dense
 //    generalised eigenproblem on the free dofs): the lowest frequencies,
 //    the released shape's share in frequency bands, and the error each
-//    integrator would make on the linearised bar, mode by mode (the scalar
-//    recurrences of backward Euler and the trapezoidal rule, exact for a
+//    integrator would make on the linearised bar, mode by mode (each
+//    integrator's scalar recurrence, lab/linear_modes.hpp: exact for a
 //    linear undamped system), in total and from the modes above a
 //    frequency. In the linear regime (about 1 degree) that prediction
 //    equals the measured error and says which modes make it; at larger
@@ -43,14 +43,11 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Dense>
-
-#include "edgefem/core/coefficients.hpp"
 #include "edgefem/core/error.hpp"
-#include "edgefem/core/reference_operator.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"
+#include "lab/linear_modes.hpp"
 
 using namespace edgefem;
 
@@ -156,78 +153,15 @@ std::vector<std::vector<double>> extrapolate(const Run& fine, const Run& coarse)
     return out;
 }
 
-// The linearised bar's modes: K at rest and the lumped M on the free dofs,
-// K phi = omega^2 M phi with phi M-orthonormal.
-struct Modes {
-    std::vector<std::size_t> dof;  // free dofs
-    Eigen::VectorXd omega;         // ascending
-    Eigen::MatrixXd phi;           // columns, M-orthonormal
-    Eigen::VectorXd m;             // lumped mass per free dof
-};
-
-Modes linear_modes(const Scene& scene) {
-    const Mesh& mesh = scene.mesh;
-    auto op = make_reference_operator<double>(mesh, scene.materials, ModelKind::FE, Method::Edge);
-    std::vector<double> zero(mesh.X.size(), 0.0), f(mesh.X.size());
-    op->forces(zero.data(), f.data(), false);
-    op->build_stiffness(false);
-    std::vector<char> fixed(std::size_t(mesh.num_vertices()), 0);
-    for (index_t v : scene.fixed) fixed[std::size_t(v)] = 1;
-    Modes md;
-    for (std::size_t i = 0; i < mesh.X.size(); ++i)
-        if (!fixed[i / 3]) md.dof.push_back(i);
-    const auto n = Eigen::Index(md.dof.size());
-    const std::vector<double> mass = lumped_mass(mesh, scene.materials);
-    md.m.resize(n);
-    for (Eigen::Index a = 0; a < n; ++a) md.m[a] = mass[md.dof[std::size_t(a)] / 3];
-    // A = M^-1/2 K M^-1/2, column by column from K e_j
-    Eigen::MatrixXd A(n, n);
-    std::vector<double> e(mesh.X.size(), 0.0), y(mesh.X.size());
-    for (Eigen::Index b = 0; b < n; ++b) {
-        e[md.dof[std::size_t(b)]] = 1;
-        op->multiply(e.data(), y.data());
-        e[md.dof[std::size_t(b)]] = 0;
-        for (Eigen::Index a = 0; a < n; ++a) A(a, b) = y[md.dof[std::size_t(a)]] / std::sqrt(md.m[a] * md.m[b]);
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es((A + A.transpose()) / 2);
-    md.omega = es.eigenvalues().cwiseMax(0.0).cwiseSqrt();
-    md.phi = md.m.cwiseSqrt().cwiseInverse().asDiagonal() * es.eigenvectors();
-    return md;
-}
-
-// x(t_k) of x'' = -omega^2 x from x(0) = 1, x'(0) = 0 at `steps` steps of
-// dt, sampled after each `every` steps: backward Euler or the trapezoidal
-// rule (Newmark 1/4, 1/2).
-std::vector<double> scalar_run(double omega, double dt, long steps, long every, bool trapezoidal) {
-    std::vector<double> out;
-    const double w2 = omega * omega;
-    double x = 1, v = 0, a = -w2;
-    for (long n = 1; n <= steps; ++n) {
-        if (trapezoidal) {
-            const double xn = (x + dt * v + dt * dt / 4 * a) / (1 + dt * dt * w2 / 4), an = -w2 * xn;
-            v += dt / 2 * (a + an);
-            x = xn;
-            a = an;
-        } else {
-            x = (x + dt * v) / (1 + dt * dt * w2);
-            v = (v - dt * w2 * x);  // v_{n+1} = v_n - dt w^2 x_{n+1}
-        }
-        if (n % every == 0) out.push_back(x);
-    }
-    return out;
-}
-
 void print_modes(const Setup& st) {
-    const Modes md = linear_modes(st.scene);
+    const lab::LinearModes md = lab::linear_modes(st.scene);
     const auto n = md.omega.size();
     constexpr double two_pi = 2 * M_PI;
     std::printf("\nlinearised modes (K at rest, lumped M, %ld free dofs): lowest frequencies (Hz):", long(n));
     for (Eigen::Index i = 0; i < std::min<Eigen::Index>(n, 12); ++i) std::printf(" %.1f", md.omega[i] / two_pi);
     std::printf("; highest %.0f\n", md.omega[n - 1] / two_pi);
-    // modal coordinates of the released shape: q = phi^T M u0
-    Eigen::VectorXd u0(n);
-    for (Eigen::Index a = 0; a < n; ++a) u0[a] = st.u0[md.dof[std::size_t(a)]];
-    const Eigen::VectorXd q = md.phi.transpose() * (md.m.asDiagonal() * u0);
+    const Eigen::VectorXd q = lab::modal_coordinates(md, st.u0);
+    const double u0_norm = norm(lab::modal_displacement(md, q, st.u0.size()));
     const double bands[] = {0, 30, 100, 300, 1000, 1e9};
     std::printf("the released shape by band: | band (Hz) | modes | share of |u0| | share of the elastic energy |\n");
     double energy = 0;
@@ -239,43 +173,44 @@ void print_modes(const Setup& st) {
         for (Eigen::Index i = 0; i < n; ++i) {
             const double fi = md.omega[i] / two_pi;
             if (fi < bands[b] || fi >= bands[b + 1]) continue;
-            part += md.phi.col(i) * q[i];
+            part[i] = q[i];
             e += 0.5 * md.omega[i] * md.omega[i] * q[i] * q[i];
             ++count;
         }
-        std::printf("| %g-%g | %d | %.3g | %.3g |\n", bands[b], bands[b + 1], count, part.norm() / u0.norm(), e / energy);
+        std::printf("| %g-%g | %d | %.3g | %.3g |\n", bands[b], bands[b + 1], count,
+                    norm(lab::modal_displacement(md, part, st.u0.size())) / u0_norm, e / energy);
     }
-    // the linearised bar's error, mode by mode: u(t) = sum phi_i q_i x_i(t)
-    std::vector<std::vector<double>> exact(static_cast<std::size_t>(n));
-    for (Eigen::Index i = 0; i < n; ++i)
-        for (int k = 1; k <= kSamples; ++k) exact[std::size_t(i)].push_back(std::cos(md.omega[i] * st.span * k / kSamples));
-    double scale = 0;
-    for (int k = 0; k < kSamples; ++k) {
-        Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
-        for (Eigen::Index i = 0; i < n; ++i) u += md.phi.col(i) * (q[i] * exact[std::size_t(i)][std::size_t(k)]);
-        scale = std::max(scale, u.norm());
-    }
+    // the linearised bar's trajectory at the sample times, exactly and by
+    // each integrator: u(t) = sum phi_i q_i x_i(t)
+    auto at_samples = [&](Integrator integ, double dt, double cut, bool exact) {
+        const long steps = std::lround(st.span / dt);
+        std::vector<std::vector<double>> u;
+        std::vector<std::vector<double>> x(static_cast<std::size_t>(n));
+        for (Eigen::Index i = 0; i < n; ++i)
+            x[std::size_t(i)] = exact ? lab::exact_mode_history(md.omega[i], dt, steps)
+                                      : lab::mode_history(integ, st.scene.integrator_parameters, md.omega[i], dt, steps);
+        for (int k = 1; k <= kSamples; ++k) {
+            Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
+            for (Eigen::Index i = 0; i < n; ++i)
+                if (md.omega[i] / two_pi >= cut) c[i] = q[i] * x[std::size_t(i)][std::size_t(steps * k / kSamples)];
+            u.push_back(lab::modal_displacement(md, c, st.u0.size()));
+        }
+        return u;
+    };
     const double cutoffs[] = {0, 30, 100, 300};
     std::printf("the linearised bar's error (max over the %d sample times / max |u|), from the modes above a frequency:\n"
                 "| integrator | dt (ms) | all modes | above 30 Hz | above 100 Hz | above 300 Hz |\n|---|---:|---:|---:|---:|---:|\n",
                 kSamples);
-    for (bool trapezoidal : {false, true})
-        for (double dt : {1e-3, 5e-4, 2.5e-4, 1.25e-4}) {
-            const long steps = std::lround(st.span / dt);
-            std::vector<std::vector<double>> x(static_cast<std::size_t>(n));
-            for (Eigen::Index i = 0; i < n; ++i)
-                x[std::size_t(i)] = scalar_run(md.omega[i], dt, steps, steps / kSamples, trapezoidal);
-            std::printf("| %s | %g |", trapezoidal ? "trapezoidal" : "backward Euler", dt * 1e3);
+    const double dts[] = {1e-3, 5e-4, 2.5e-4, 1.25e-4};
+    double scale = 0;
+    for (const auto& u : at_samples(Integrator::Newmark, dts[3], 0, true)) scale = std::max(scale, norm(u));
+    for (Integrator integ : {Integrator::Implicit, Integrator::Newmark, Integrator::GeneralizedAlpha, Integrator::Bdf2})
+        for (double dt : dts) {
+            std::printf("| %s | %g |", to_string(integ), dt * 1e3);
             for (double cut : cutoffs) {
+                const auto u = at_samples(integ, dt, cut, false), ref = at_samples(integ, dt, cut, true);
                 double worst = 0;
-                for (int k = 0; k < kSamples; ++k) {
-                    Eigen::VectorXd d = Eigen::VectorXd::Zero(n);
-                    for (Eigen::Index i = 0; i < n; ++i)
-                        if (md.omega[i] / two_pi >= cut)
-                            d += md.phi.col(i) *
-                                 (q[i] * (x[std::size_t(i)][std::size_t(k)] - exact[std::size_t(i)][std::size_t(k)]));
-                    worst = std::max(worst, d.norm() / scale);
-                }
+                for (int k = 0; k < kSamples; ++k) worst = std::max(worst, distance(u[std::size_t(k)], ref[std::size_t(k)]) / scale);
                 std::printf(" %.3g |", worst);
             }
             std::printf("\n");

@@ -1,0 +1,139 @@
+#include "lab/linear_modes.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/error.hpp"
+#include "edgefem/core/reference_operator.hpp"
+
+namespace edgefem::lab {
+
+LinearModes linear_modes(const Scene& scene) {
+    if (!scene.prescribed.empty()) throw InvalidArgument("linear_modes: prescribed vertices are not a free vibration");
+    const Mesh& mesh = scene.mesh;
+    std::vector<char> fixed(std::size_t(mesh.num_vertices()), 0);
+    for (index_t v : scene.fixed) fixed[std::size_t(v)] = 1;
+    LinearModes md;
+    for (std::size_t i = 0; i < mesh.X.size(); ++i)
+        if (!fixed[i / 3]) md.dof.push_back(i);
+    const auto n = Eigen::Index(md.dof.size());
+    if (n > 3000) throw InvalidArgument("linear_modes: " + std::to_string(n) + " free dofs (dense: at most 3,000)");
+    auto op = make_reference_operator<double>(mesh, scene.materials, ModelKind::FE, Method::Edge);
+    std::vector<double> zero(mesh.X.size(), 0.0), y(mesh.X.size());
+    op->forces(zero.data(), y.data(), false);
+    op->build_stiffness(false);
+    const std::vector<double> mass = lumped_mass(mesh, scene.materials);
+    md.mass.resize(n);
+    for (Eigen::Index a = 0; a < n; ++a) md.mass[a] = mass[md.dof[std::size_t(a)] / 3];
+    // M^-1/2 K M^-1/2, a column per product K e_b
+    Eigen::MatrixXd A(n, n);
+    std::vector<double> e(mesh.X.size(), 0.0);
+    for (Eigen::Index b = 0; b < n; ++b) {
+        e[md.dof[std::size_t(b)]] = 1;
+        op->multiply(e.data(), y.data());
+        e[md.dof[std::size_t(b)]] = 0;
+        for (Eigen::Index a = 0; a < n; ++a) A(a, b) = y[md.dof[std::size_t(a)]] / std::sqrt(md.mass[a] * md.mass[b]);
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es((A + A.transpose()) / 2);
+    md.omega = es.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    md.phi = md.mass.cwiseSqrt().cwiseInverse().asDiagonal() * es.eigenvectors();
+    return md;
+}
+
+Eigen::VectorXd modal_coordinates(const LinearModes& modes, const std::vector<double>& u) {
+    Eigen::VectorXd mu(modes.mass.size());
+    for (Eigen::Index a = 0; a < mu.size(); ++a) mu[a] = modes.mass[a] * u[modes.dof[std::size_t(a)]];
+    return modes.phi.transpose() * mu;
+}
+
+std::vector<double> modal_displacement(const LinearModes& modes, const Eigen::VectorXd& q, std::size_t size) {
+    const Eigen::VectorXd free = modes.phi * q;
+    std::vector<double> u(size, 0.0);
+    for (Eigen::Index a = 0; a < free.size(); ++a) u[modes.dof[std::size_t(a)]] = free[a];
+    return u;
+}
+
+namespace {
+
+// The Newmark family with alpha_m, alpha_f (generalized-alpha; 0, 0:
+// Newmark): (1 - am) a' + am a = -w2 ((1 - af) x' + af x),
+// x' = x + T v + T^2 ((1/2 - beta) a + beta a'), v' = v + T ((1 - gamma) a + gamma a').
+std::vector<double> newmark_family(double w2, double T, long steps, double beta, double gamma, double am, double af) {
+    std::vector<double> x{1.0};
+    double u = 1, v = 0, a = -w2;
+    for (long k = 0; k < steps; ++k) {
+        const double pred = u + T * v + T * T * (0.5 - beta) * a;
+        // a' = (x' - pred) / (beta T^2); (1 - am) a' + am a + w2 ((1 - af) x' + af u) = 0
+        const double ci = (1 - am) / (beta * T * T);
+        const double xn = (ci * pred - am * a - w2 * af * u) / (ci + w2 * (1 - af));
+        const double an = (xn - pred) / (beta * T * T);
+        v += T * ((1 - gamma) * a + gamma * an);
+        u = xn;
+        a = an;
+        x.push_back(u);
+    }
+    return x;
+}
+
+}  // namespace
+
+std::vector<double> mode_history(Integrator integrator, const IntegratorParameters& parameters, double omega,
+                                 double dt, long steps) {
+    const double w2 = omega * omega, T = dt;
+    switch (integrator) {
+    case Integrator::Newmark:
+    case Integrator::NewmarkLinear:
+        return newmark_family(w2, T, steps, parameters.newmark_beta, parameters.newmark_gamma, 0, 0);
+    case Integrator::GeneralizedAlpha:
+    case Integrator::GeneralizedAlphaLinear: {
+        const double rho = parameters.rho_inf;
+        const double am = (2 * rho - 1) / (rho + 1), af = rho / (rho + 1);
+        return newmark_family(w2, T, steps, 0.25 * (1 - am + af) * (1 - am + af), 0.5 - am + af, am, af);
+    }
+    default:
+        break;
+    }
+    std::vector<double> x{1.0};
+    double u = 1, v = 0, u1 = 0, v1 = 0;
+    for (long k = 0; k < steps; ++k) {
+        double un = 0, vn = 0;
+        switch (integrator) {
+        case Integrator::Explicit:  // symplectic Euler
+            vn = v - T * w2 * u;
+            un = u + T * vn;
+            break;
+        case Integrator::Verlet:
+            un = u + T * v - 0.5 * T * T * w2 * u;
+            vn = v - 0.5 * T * w2 * (u + un);
+            break;
+        case Integrator::Bdf2:
+        case Integrator::Bdf2Linear:
+            if (k > 0) {  // x' = (4x - x_1) / 3 + 2T/3 v',  v' = (4v - v_1) / 3 + 2T/3 a'
+                const double c = 2 * T / 3;
+                un = ((4 * u - u1) / 3 + c * (4 * v - v1) / 3) / (1 + c * c * w2);
+                vn = (4 * v - v1) / 3 - c * w2 * un;
+                break;
+            }
+            [[fallthrough]];
+        default:  // backward Euler (Implicit, SemiImplicit)
+            un = (u + T * v) / (1 + T * T * w2);
+            vn = v - T * w2 * un;
+            break;
+        }
+        u1 = u;
+        v1 = v;
+        u = un;
+        v = vn;
+        x.push_back(u);
+    }
+    return x;
+}
+
+std::vector<double> exact_mode_history(double omega, double dt, long steps) {
+    std::vector<double> x;
+    for (long k = 0; k <= steps; ++k) x.push_back(std::cos(omega * double(k) * dt));
+    return x;
+}
+
+}  // namespace edgefem::lab
