@@ -223,15 +223,18 @@ int main(int argc, char** argv) {
     const double degrees = argc > 1 ? std::atof(argv[1]) : 90;
     const std::string shape = argc > 2 ? argv[2] : "linear";
     const double span = argc > 3 ? std::atof(argv[3]) : 0.5;
-    if (!(degrees > 0 && degrees <= 360) || (shape != "linear" && shape != "mode") || !(span > 0 && span <= 10)) {
-        std::fprintf(stderr, "usage: edgefem_twist_study [DEGREES in (0, 360] [linear|mode [SECONDS in (0, 10]]]\n");
+    const bool modes_only = argc > 4 && std::string(argv[4]) == "modes-only";
+    if (!(degrees > 0 && degrees <= 360) || (shape != "linear" && shape != "mode") || !(span > 0 && span <= 10) ||
+        (argc > 4 && !modes_only) || argc > 5) {
+        std::fprintf(stderr,
+                     "usage: edgefem_twist_study [DEGREES in (0, 360] [linear|mode [SECONDS in (0, 10] [modes-only]]]]\n");
         return 2;
     }
     const Setup st = make_setup(degrees, shape == "mode", span);
     std::printf("twisted bar released from %g degrees (%s profile), %g s, %d sample times\n", degrees, shape.c_str(), span,
                 kSamples);
     print_modes(st);
-    if (argc > 4 && std::string(argv[4]) == "modes-only") return 0;
+    if (modes_only) return 0;
 
     const Run ref = simulate(st, Integrator::Verlet, 2.5e-6), ref2 = simulate(st, Integrator::Verlet, 5e-6);
     if (!ref.failure.empty() || !ref2.failure.empty()) {
