@@ -126,6 +126,7 @@ TEST(ModalDynamics, EveryIntegratorFollowsItsRecurrenceModeByMode) {
         Integrator integrator;
         IntegratorParameters parameters;
         Method method = Method::Edge;
+        ModelKind model = ModelKind::FE;
     };
     IntegratorParameters damped_newmark;  // first order, damped: gamma > 1/2
     damped_newmark.newmark_beta = 0.3;
@@ -142,21 +143,24 @@ TEST(ModalDynamics, EveryIntegratorFollowsItsRecurrenceModeByMode) {
         {Integrator::Bdf2, {}},           {Integrator::Bdf2Linear, {}},
         // the per-tet method: the same K, so the same modes
         {Integrator::Newmark, {}, Method::Tet}, {Integrator::SemiImplicit, {}, Method::Tet},
+        // the spring network: its own K, its own modes
+        {Integrator::Newmark, {}, Method::Edge, ModelKind::SN}, {Integrator::Bdf2Linear, {}, Method::Edge, ModelKind::SN},
     };
     for (const Case& c : cases) {
         Scene s = bar();
         s.integrator = c.integrator;
         s.integrator_parameters = c.parameters;
         s.method = c.method;
+        s.model = c.model;
         s.dt = is_explicit(c.integrator) ? explicit_dt : 2e-3;
         const Comparison r = compare(std::move(s), 100);
-        SCOPED_TRACE(std::string(to_string(c.integrator)) + (c.method == Method::Tet ? " per-tet" : "") + " beta " + std::to_string(c.parameters.newmark_beta) +
+        SCOPED_TRACE(std::string(to_string(c.integrator)) + (c.method == Method::Tet ? " per-tet" : "") + (c.model == ModelKind::SN ? " SN" : "") + " beta " + std::to_string(c.parameters.newmark_beta) +
                      " gamma " + std::to_string(c.parameters.newmark_gamma) + " rho_inf " +
                      std::to_string(c.parameters.rho_inf));
         EXPECT_GT(r.scale, 0.5 * kAmplitude);
         EXPECT_LT(r.worst, 1e-6);
         std::printf("%-26s %-8s beta %.2f gamma %.2f rho_inf %.2f: %.2e of the largest displacement\n",
-                    to_string(c.integrator), c.method == Method::Tet ? "per-tet" : "edge", c.parameters.newmark_beta, c.parameters.newmark_gamma,
+                    to_string(c.integrator), c.method == Method::Tet ? "per-tet" : c.model == ModelKind::SN ? "edge SN" : "edge", c.parameters.newmark_beta, c.parameters.newmark_gamma,
                     c.parameters.rho_inf, r.worst);
     }
 }

@@ -19,7 +19,9 @@ LinearModes linear_modes(const Scene& scene) {
         if (!fixed[i / 3]) md.dof.push_back(i);
     const auto n = Eigen::Index(md.dof.size());
     if (n > 3000) throw InvalidArgument("linear_modes: " + std::to_string(n) + " free dofs (dense: at most 3,000)");
-    auto op = make_reference_operator<double>(mesh, scene.materials, ModelKind::FE, Method::Edge);
+    // the scene's model (edge FE or SN) through the reference back-end's
+    // edge loops (the per-tet method's K is edge FE's)
+    auto op = make_reference_operator<double>(mesh, scene.materials, scene.model, Method::Edge);
     std::vector<double> zero(mesh.X.size(), 0.0), y(mesh.X.size());
     op->forces(zero.data(), y.data(), false);
     op->build_stiffness(false);

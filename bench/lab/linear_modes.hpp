@@ -1,5 +1,6 @@
 // A scene's linearised dynamics about its rest shape, mode by mode: K at
-// rest (edge FE, the reference back-end) and the lumped M on the free dofs
+// rest (the scene's model, edge FE or SN, from the reference back-end) and
+// the lumped M on the free dofs
 // (every vertex not in scene.fixed), K phi = omega^2 M phi with
 // M-orthonormal phi; and each integrator's scalar recurrence on
 // x'' = -omega^2 x. On a linear undamped system every integrator of the
