@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cantilever.hpp"
+#include "edgefem/core/error.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/parallel/cpu_backend.hpp"
 #include "lab/linear_modes.hpp"
@@ -188,7 +189,43 @@ TEST(ModalDynamics, TheRecurrencesTellTheIntegratorsApart) {
     const auto exact = trajectory_end(Integrator::Newmark, p, true);
     for (Integrator a : {Integrator::Implicit, Integrator::Newmark, Integrator::GeneralizedAlpha, Integrator::Bdf2}) {
         EXPECT_GT(distance(trajectory_end(a, p, false), exact), 1e-3) << to_string(a);
-        for (Integrator b : {Integrator::Implicit, Integrator::Newmark, Integrator::GeneralizedAlpha, Integrator::Bdf2})
-            if (a != b) EXPECT_GT(distance(trajectory_end(a, p, false), trajectory_end(b, p, false)), 1e-3);
+        for (Integrator b : {Integrator::Implicit, Integrator::Newmark, Integrator::GeneralizedAlpha, Integrator::Bdf2}) {
+            if (a != b) {
+                EXPECT_GT(distance(trajectory_end(a, p, false), trajectory_end(b, p, false)), 1e-3);
+            }
+        }
     }
+}
+
+// What the recurrences do not model is refused by name, and so are vectors
+// of the wrong length.
+TEST(ModalDynamics, WhatTheModesDoNotModelIsAnError) {
+    auto message = [](const Scene& s) {
+        try {
+            lab::linear_modes(s);
+        } catch (const InvalidArgument& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    Scene damped = bar();
+    damped.rayleigh_beta = 1e-3;
+    EXPECT_NE(message(damped).find("rayleigh_beta"), std::string::npos) << message(damped);
+    Scene loaded = bar();
+    loaded.gravity = {0, 0, -9.81};
+    EXPECT_NE(message(loaded).find("gravity"), std::string::npos) << message(loaded);
+    Scene held = bar();
+    held.prescribed.push_back({held.mesh.num_vertices() - 1, {0, 0, 0}});
+    EXPECT_NE(message(held).find("prescribed"), std::string::npos) << message(held);
+    Scene big = test::clamped_box_scene(30, 6, 6, 1e5);
+    big.gravity = {0, 0, 0};
+    EXPECT_NE(message(big).find("free dofs"), std::string::npos) << message(big);
+    Scene bad = bar();
+    bad.fixed.push_back(bad.mesh.num_vertices());  // out of range: Scene::validate names it
+    EXPECT_NE(message(bad).find("fixed["), std::string::npos) << message(bad);
+
+    const lab::LinearModes md = lab::linear_modes(bar());
+    EXPECT_THROW(lab::modal_coordinates(md, std::vector<double>(3)), InvalidArgument);
+    EXPECT_THROW(lab::modal_displacement(md, Eigen::VectorXd::Zero(md.omega.size()), 3), InvalidArgument);
+    EXPECT_THROW(lab::modal_displacement(md, Eigen::VectorXd::Zero(2), bar().mesh.X.size()), InvalidArgument);
 }

@@ -1,5 +1,6 @@
 #include "lab/linear_modes.hpp"
 
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -10,7 +11,13 @@
 namespace edgefem::lab {
 
 LinearModes linear_modes(const Scene& scene) {
+    scene.validate();
+    // what the recurrences do not model: a free, undamped, unloaded vibration only
     if (!scene.prescribed.empty()) throw InvalidArgument("linear_modes: prescribed vertices are not a free vibration");
+    if (scene.rayleigh_alpha != 0 || scene.rayleigh_beta != 0)
+        throw InvalidArgument("linear_modes: damping (rayleigh_alpha, rayleigh_beta) is not modelled");
+    if (scene.gravity != std::array<double, 3>{0, 0, 0} || !scene.load.empty() || !scene.surface_loads.empty())
+        throw InvalidArgument("linear_modes: loads (gravity, load, surface_loads) are not modelled");
     const Mesh& mesh = scene.mesh;
     std::vector<char> fixed(std::size_t(mesh.num_vertices()), 0);
     for (index_t v : scene.fixed) fixed[std::size_t(v)] = 1;
@@ -43,13 +50,28 @@ LinearModes linear_modes(const Scene& scene) {
     return md;
 }
 
+namespace {
+
+void check_size(const LinearModes& modes, std::size_t size, const char* what) {
+    if (!modes.dof.empty() && size <= modes.dof.back())
+        throw InvalidArgument(std::string(what) + ": " + std::to_string(size) + " entries, the modes need " +
+                              std::to_string(modes.dof.back() + 1));
+}
+
+}  // namespace
+
 Eigen::VectorXd modal_coordinates(const LinearModes& modes, const std::vector<double>& u) {
+    check_size(modes, u.size(), "modal_coordinates: u");
     Eigen::VectorXd mu(modes.mass.size());
     for (Eigen::Index a = 0; a < mu.size(); ++a) mu[a] = modes.mass[a] * u[modes.dof[std::size_t(a)]];
     return modes.phi.transpose() * mu;
 }
 
 std::vector<double> modal_displacement(const LinearModes& modes, const Eigen::VectorXd& q, std::size_t size) {
+    check_size(modes, size, "modal_displacement: size");
+    if (q.size() != modes.phi.cols())
+        throw InvalidArgument("modal_displacement: " + std::to_string(q.size()) + " modal coordinates, the modes are " +
+                              std::to_string(modes.phi.cols()));
     const Eigen::VectorXd free = modes.phi * q;
     std::vector<double> u(size, 0.0);
     for (Eigen::Index a = 0; a < free.size(); ++a) u[modes.dof[std::size_t(a)]] = free[a];

@@ -1,14 +1,14 @@
 // A scene's linearised dynamics about its rest shape, mode by mode: K at
 // rest (the scene's model, edge FE or SN, from the reference back-end) and
-// the lumped M on the free dofs
-// (every vertex not in scene.fixed), K phi = omega^2 M phi with
-// M-orthonormal phi; and each integrator's scalar recurrence on
-// x'' = -omega^2 x. On a linear undamped system every integrator of the
-// library is a linear recurrence that the modes decouple exactly, so these
-// predict a simulator's discrete trajectory (its period error, its
-// numerical damping) from outside the simulator: tests/test_modal_dynamics.cpp
-// checks the integrators against them, bench/twist_study.cpp explains
-// errors with them. Dense: small meshes only (at most 3,000 free dofs).
+// the lumped M on the free dofs (every vertex not in scene.fixed),
+// K phi = omega^2 M phi with M-orthonormal phi; and each integrator's
+// scalar recurrence on x'' = -omega^2 x. On a linear undamped system every
+// integrator of the library is a linear recurrence that the modes decouple
+// exactly, so these predict a simulator's discrete trajectory (its period
+// error, its numerical damping) from outside the simulator:
+// tests/test_modal_dynamics.cpp checks the integrators against them,
+// bench/twist_study.cpp explains errors with them. Dense: small meshes only
+// (at most 3,000 free dofs).
 #pragma once
 
 #include <Eigen/Dense>
@@ -25,17 +25,20 @@ struct LinearModes {
     Eigen::VectorXd mass;          // the lumped mass of each free dof
 };
 
-// Throws InvalidArgument for prescribed vertices (not a free vibration) and
-// for more than 3,000 free dofs.
+// Throws InvalidArgument for what the recurrences do not model (prescribed
+// vertices, damping, gravity or loads), for more than 3,000 free dofs, and
+// as Scene::validate() does.
 LinearModes linear_modes(const Scene& scene);
 
-// q = phi^T M u (u: 3 #V; its fixed dofs are ignored).
+// q = phi^T M u (u: 3 #V; its fixed dofs are ignored). Throws
+// InvalidArgument where u is too short.
 Eigen::VectorXd modal_coordinates(const LinearModes& modes, const std::vector<double>& u);
 
-// u = phi q as 3 #V displacements (zero at the fixed dofs).
+// u = phi q as `size` (3 #V) displacements, zero at the fixed dofs. Throws
+// InvalidArgument for a size too small or a q of another length.
 std::vector<double> modal_displacement(const LinearModes& modes, const Eigen::VectorXd& q, std::size_t size);
 
-// x_n for n = 0 .. steps of x'' = -omega^2 x from x = 1, x' = 0, by the
+// x_n for n = 0 .. steps of x'' = -omega^2 x from x = 1, x' = 0 (at rest), by the
 // integrator's recurrence at step dt (the linearised forms are their
 // Newton forms' recurrences; BDF2 starts with a backward Euler step;
 // Newmark and generalized-alpha from the consistent acceleration).
