@@ -12,10 +12,9 @@ namespace edgefem::lab {
 
 LinearModes linear_modes(const Scene& scene) {
     scene.validate();
-    // what the recurrences do not model: a free, undamped, unloaded vibration only
+    // what the recurrences do not model: a free, unloaded vibration only
+    // (Rayleigh damping is: alpha M + beta K is diagonal in the modes)
     if (!scene.prescribed.empty()) throw InvalidArgument("linear_modes: prescribed vertices are not a free vibration");
-    if (scene.rayleigh_alpha != 0 || scene.rayleigh_beta != 0)
-        throw InvalidArgument("linear_modes: damping (rayleigh_alpha, rayleigh_beta) is not modelled");
     if (scene.gravity != std::array<double, 3>{0, 0, 0} || !scene.load.empty() || !scene.surface_loads.empty())
         throw InvalidArgument("linear_modes: loads (gravity, load, surface_loads) are not modelled");
     const Mesh& mesh = scene.mesh;
@@ -81,19 +80,19 @@ std::vector<double> modal_displacement(const LinearModes& modes, const Eigen::Ve
 namespace {
 
 // The Newmark family with alpha_m, alpha_f (generalized-alpha; 0, 0:
-// Newmark): (1 - am) a' + am a = -w2 ((1 - af) x' + af x),
+// Newmark) and the mode's damping c = alpha + beta omega^2:
+// (1 - am) a' + am a + (1 - af) (c v' + w2 x') + af (c v + w2 x) = 0,
 // x' = x + T v + T^2 ((1/2 - beta) a + beta a'), v' = v + T ((1 - gamma) a + gamma a').
-std::vector<double> newmark_family(double w2, double T, long steps, double beta, double gamma, double am, double af) {
+std::vector<double> newmark_family(double w2, double c, double T, long steps, double beta, double gamma, double am,
+                                   double af) {
     std::vector<double> x{1.0};
-    double u = 1, v = 0, a = -w2;
+    double u = 1, v = 0, a = -w2;  // the balance's acceleration at rest: -c v - w2 u
     for (long k = 0; k < steps; ++k) {
-        const double pred = u + T * v + T * T * (0.5 - beta) * a;
-        // a' = (x' - pred) / (beta T^2); (1 - am) a' + am a + w2 ((1 - af) x' + af u) = 0
-        const double ci = (1 - am) / (beta * T * T);
-        const double xn = (ci * pred - am * a - w2 * af * u) / (ci + w2 * (1 - af));
-        const double an = (xn - pred) / (beta * T * T);
-        v += T * ((1 - gamma) * a + gamma * an);
-        u = xn;
+        const double pred = u + T * v + T * T * (0.5 - beta) * a, vpred = v + T * (1 - gamma) * a;
+        const double an = -(am * a + (1 - af) * (c * vpred + w2 * pred) + af * (c * v + w2 * u)) /
+                          ((1 - am) + (1 - af) * (c * gamma * T + w2 * beta * T * T));
+        u = pred + beta * T * T * an;
+        v = vpred + gamma * T * an;
         a = an;
         x.push_back(u);
     }
@@ -103,17 +102,19 @@ std::vector<double> newmark_family(double w2, double T, long steps, double beta,
 }  // namespace
 
 std::vector<double> mode_history(Integrator integrator, const IntegratorParameters& parameters, double omega,
-                                 double dt, long steps) {
-    const double w2 = omega * omega, T = dt;
+                                 double dt, long steps, double alpha, double beta) {
+    if (integrator == Integrator::Verlet && (alpha != 0 || beta != 0))
+        throw InvalidArgument("mode_history: verlet takes no damping");
+    const double w2 = omega * omega, T = dt, c = alpha + beta * w2;
     switch (integrator) {
     case Integrator::Newmark:
     case Integrator::NewmarkLinear:
-        return newmark_family(w2, T, steps, parameters.newmark_beta, parameters.newmark_gamma, 0, 0);
+        return newmark_family(w2, c, T, steps, parameters.newmark_beta, parameters.newmark_gamma, 0, 0);
     case Integrator::GeneralizedAlpha:
     case Integrator::GeneralizedAlphaLinear: {
         const double rho = parameters.rho_inf;
         const double am = (2 * rho - 1) / (rho + 1), af = rho / (rho + 1);
-        return newmark_family(w2, T, steps, 0.25 * (1 - am + af) * (1 - am + af), 0.5 - am + af, am, af);
+        return newmark_family(w2, c, T, steps, 0.25 * (1 - am + af) * (1 - am + af), 0.5 - am + af, am, af);
     }
     default:
         break;
@@ -123,8 +124,8 @@ std::vector<double> mode_history(Integrator integrator, const IntegratorParamete
     for (long k = 0; k < steps; ++k) {
         double un = 0, vn = 0;
         switch (integrator) {
-        case Integrator::Explicit:  // symplectic Euler
-            vn = v - T * w2 * u;
+        case Integrator::Explicit:  // symplectic Euler: alpha implicit, beta K v at the step's start
+            vn = (v - T * (w2 * u + beta * w2 * v)) / (1 + T * alpha);
             un = u + T * vn;
             break;
         case Integrator::Verlet:
@@ -133,16 +134,16 @@ std::vector<double> mode_history(Integrator integrator, const IntegratorParamete
             break;
         case Integrator::Bdf2:
         case Integrator::Bdf2Linear:
-            if (k > 0) {  // x' = (4x - x_1) / 3 + 2T/3 v',  v' = (4v - v_1) / 3 + 2T/3 a'
-                const double c = 2 * T / 3;
-                un = ((4 * u - u1) / 3 + c * (4 * v - v1) / 3) / (1 + c * c * w2);
-                vn = (4 * v - v1) / 3 - c * w2 * un;
+            if (k > 0) {  // x' = X + h v',  v' = V + h a',  a' = -c v' - w2 x'  (h = 2T/3)
+                const double h = 2 * T / 3, X = (4 * u - u1) / 3, V = (4 * v - v1) / 3;
+                vn = (V - h * w2 * X) / (1 + h * c + h * h * w2);
+                un = X + h * vn;
                 break;
             }
             [[fallthrough]];
-        default:  // backward Euler (Implicit, SemiImplicit)
-            un = (u + T * v) / (1 + T * T * w2);
-            vn = v - T * w2 * un;
+        default:  // backward Euler (Implicit, SemiImplicit): v' = v + T a', x' = x + T v'
+            vn = (v - T * w2 * u) / (1 + T * c + T * T * w2);
+            un = u + T * vn;
             break;
         }
         u1 = u;
