@@ -7,7 +7,6 @@
 // / 2), about 2 / (beta omega_max^2) once xi >> 1: stiffness damping
 // shortens the explicit step.
 #include "integrators/time_integrator.hpp"
-#include "simulator/timing.hpp"
 
 namespace edgefem::sim {
 
@@ -36,9 +35,7 @@ private:
     // operator there).
     void stiffness_damping() {
         const std::size_t n = s_.n();
-        const auto t0 = Clock::now();
-        s_.op->build_stiffness(s_.scene.solver.definite_stiffness);
-        s_.stats.stiffness_ms += ms_since(t0);
+        s_.build_stiffness();
         v_.resize(n);
         kv_.resize(n);
         s_.kernels.from_state(v_.data(), s_.v.data(), n);

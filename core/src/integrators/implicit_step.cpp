@@ -27,7 +27,7 @@ void ImplicitStep<S>::begin(double T) {
     damping_ = nullptr;
     if (scene.rayleigh_beta <= 0) return;
     if (linear_) {  // the step's K is K0: built once, here, and solved with
-        solve_.build_stiffness(scene.solver.definite_stiffness);
+        s_.build_stiffness();
         damping_ = s_.op.get();
     } else {
         s_.build_damping_tangent(op_damp_);

@@ -242,6 +242,13 @@ double SimState<S>::forces(bool energy) {
 }
 
 template <class S>
+void SimState<S>::build_stiffness() {
+    const auto t0 = Clock::now();
+    op->build_stiffness(scene.solver.definite_stiffness);
+    stats.stiffness_ms += ms_since(t0);
+}
+
+template <class S>
 void SimState<S>::start_forces() {
     if (!forces_current) forces(false);
     forces_current = false;

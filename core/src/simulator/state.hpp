@@ -125,6 +125,11 @@ struct SimState {
 
     // f at u (timed as force_ms); W when `energy`.
     double forces(bool energy);
+    // K of op at its last forces() state with the scene's
+    // definite_stiffness (timed as stiffness_ms), for a step that applies
+    // K before or outside a solve (the explicit step's and the linearised
+    // steps' stiffness damping).
+    void build_stiffness();
     // The internal forces at the step's start, unless the energy guard has
     // just evaluated them at this state.
     void start_forces();

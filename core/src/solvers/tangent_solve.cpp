@@ -21,13 +21,6 @@ CgResult TangentSolve<S>::solve(double c_m, double c_k, double c_b, const Elasti
 }
 
 template <class S>
-void TangentSolve<S>::build_stiffness(bool definite) {
-    const auto t0 = Clock::now();
-    s_.op->build_stiffness(definite);
-    s_.stats.stiffness_ms += ms_since(t0);
-}
-
-template <class S>
 CgResult TangentSolve<S>::solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0,
                                      double tolerance, bool definite, Stiffness stiffness, int fixed_iterations,
                                      const double* direction) {

@@ -14,9 +14,9 @@
 namespace edgefem::sim {
 
 // What a solve does with K: build it at the operator's last forces() state
-// (and set up the solver), take the one built by build_stiffness() since
-// that state (and set up the solver on it), or reuse the K and set-up of
-// an earlier solve where the solver allows (SolverSettings::
+// (and set up the solver), take the one SimState::build_stiffness() built
+// since that state (and set up the solver on it), or reuse the K and
+// set-up of an earlier solve where the solver allows (SolverSettings::
 // stiffness_interval).
 enum class Stiffness { Build, Built, Reuse };
 
@@ -40,9 +40,6 @@ public:
     CgResult solve_once(double c_m, double c_k, double c_b, const ElasticOperator<S>* K0, double tolerance,
                         bool definite, Stiffness stiffness = Stiffness::Build, int fixed_iterations = 0,
                         const double* direction = nullptr);
-    // K at the operator's last forces() state, timed as the solves' builds
-    // are, for a step that applies it before its solve (Stiffness::Built).
-    void build_stiffness(bool definite);
 
     // For a checkpoint: the solver's set-up that may outlive a step and the
     // lagged K (stiffness_interval > 1); load() rebuilds them.
