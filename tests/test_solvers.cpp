@@ -340,7 +340,7 @@ TEST(SmoothedAggregation, RebuildOnATurnedBodyIsAFreshBuildThere) {
 }
 
 // rebuild() is one thread's fixed order, the V-cycle's passes bitwise the
-// serial ones: on 2 threads (P held transposed) the rebuilt hierarchy's
+// serial ones: on 2 threads (P grouped by columns) the rebuilt hierarchy's
 // V-cycle, prolongators and coarse operators are the serial bits, and a
 // second rebuild on the same input gives them again.
 TEST(SmoothedAggregation, RebuildGivesTheSameBitsOnAnyThreadCount) {
@@ -646,9 +646,10 @@ TEST(SmoothedAggregation, DenseCoarsestOutsideZeroToOneIsAnError) {
 }
 
 // On an executor's threads the V-cycle and a smoother application give
-// bitwise what they give serially (every pass splits into fixed blocks; the
-// P^T held instead of P adds each coarse entry's terms in P's scatter's
-// order, and its scatter each fine entry's in P's gather's), for 2 and 3
+// bitwise what they give serially (every pass splits into fixed blocks; P
+// grouped by columns instead of rows adds each coarse entry's terms in the
+// order of the serial restriction's scatter, and its prolongation's scatter
+// each fine entry's in the serial gather's: amg/block_rows.hpp), for 2 and 3
 // threads and an executor set before or after build(); and hold no more
 // memory.
 TEST(SmoothedAggregation, ThreadsGiveTheSerialBits) {
@@ -679,7 +680,7 @@ TEST(SmoothedAggregation, ThreadsGiveTheSerialBits) {
                 par.smooth(0, r.data(), sm.data(), fine);
                 EXPECT_EQ(0, std::memcmp(z.data(), z0.data(), sizeof(double) * std::size_t(z.size())));
                 EXPECT_EQ(0, std::memcmp(sm.data(), s0.data(), sizeof(double) * std::size_t(sm.size())));
-                EXPECT_LE(par.bytes(), serial.bytes());  // P^T held instead of P, not beside it
+                EXPECT_LE(par.bytes(), serial.bytes());  // P regrouped, not held twice
             }
     }
 }
@@ -690,7 +691,7 @@ TEST(SmoothedAggregation, ThreadsGiveTheSerialBits) {
 // above the diagonal, each coarser non-coarsest level's products, the
 // restriction and prolongation through each P and the two triangular solves
 // with the dense coarsest factor. The same whichever way P is held (P with
-// one thread, its transpose with more).
+// one thread, grouped by columns with more).
 TEST(SmoothedAggregation, CycleCostCountsTheHierarchysEntries) {
     const BoxSystem sys = box_system(16, 8, 8, 10);
     const SparseRows& A = sys.A;

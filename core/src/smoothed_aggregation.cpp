@@ -6,10 +6,13 @@
 
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/executor.hpp"
+#include "amg/block_rows.hpp"
 #include "amg/coarse_ldlt.hpp"
 #include "amg/galerkin_product.hpp"
 
 namespace edgefem {
+
+using amg::BlockRows;
 
 namespace {
 
@@ -226,226 +229,6 @@ double largest_eigenvalue(const SparseRows& A, const std::vector<double>& Dinv, 
     return lambda;
 }
 
-// A sparse matrix kept for the V-cycle as dense rb x cb blocks (a node's
-// dofs against a node's or an aggregate's modes: 3 x 6 and 6 x 6 for the
-// prolongators, 6 x 6 for the coarse operators), float values and one int
-// per block: 4.2-4.4 bytes per entry against 8 for float values with an
-// int per entry. The preconditioner stays a fixed symmetric operator (R =
-// P^T reads the same rounded values; a symmetric matrix rounded entrywise
-// stays symmetric); the products accumulate in double, each row's terms in
-// increasing column order (a block's zeros add nothing).
-struct BlockRows {
-    Eigen::Index rows = 0, cols = 0;
-    int rb = 1, cb = 1;           // block rows and columns
-    std::vector<int> start, col;  // per block row, its blocks [start[I], start[I + 1]) and their block columns
-    std::vector<float> val;       // rb x cb per block, row-major
-
-    void assign(const SparseRows& M, int row_block, int col_block) {
-        rows = M.rows();
-        cols = M.cols();
-        rb = row_block;
-        cb = col_block;
-        if (rows % rb != 0 || cols % cb != 0) throw Error("AMG: a matrix is not made of whole blocks");
-        const std::size_t nbr = std::size_t(rows / rb), w = std::size_t(rb) * std::size_t(cb);
-        start.assign(nbr + 1, 0);
-        col.clear();
-        val.clear();
-        std::vector<int> slot(std::size_t(cols / cb), -1);  // block column -> its block in the current row, -1 none
-        std::vector<int> here;
-        for (std::size_t I = 0; I < nbr; ++I) {
-            here.clear();
-            for (int i = 0; i < rb; ++i)
-                for (SparseRows::InnerIterator it(M, Eigen::Index(I) * rb + i); it; ++it) {
-                    const std::size_t J = std::size_t(it.col() / cb);
-                    if (it.value() != 0 && slot[J] == -1) {
-                        slot[J] = 0;
-                        here.push_back(int(J));
-                    }
-                }
-            std::sort(here.begin(), here.end());
-            for (const int J : here) {
-                slot[std::size_t(J)] = int(col.size());
-                col.push_back(J);
-            }
-            val.resize(col.size() * w, 0.0f);
-            for (int i = 0; i < rb; ++i)
-                for (SparseRows::InnerIterator it(M, Eigen::Index(I) * rb + i); it; ++it)
-                    if (it.value() != 0) {
-                        const std::size_t k = std::size_t(slot[std::size_t(it.col() / cb)]);
-                        val[(k * std::size_t(rb) + std::size_t(i)) * std::size_t(cb) + std::size_t(it.col() % cb)] =
-                            float(it.value());
-                    }
-            for (const int J : here) slot[std::size_t(J)] = -1;
-            start[I + 1] = int(col.size());
-        }
-    }
-    // Calls f(B, C) with the block sizes as compile-time constants where
-    // they are the usual 3 and 6 (the loops below then unroll), as 0 (read
-    // rb and cb at run time) otherwise. The same arithmetic either way.
-    template <class F>
-    void with_sizes(const F& f) const {
-        using Three = std::integral_constant<int, 3>;
-        using Six = std::integral_constant<int, 6>;
-        using Any = std::integral_constant<int, 0>;
-        if (rb == 6 && cb == 6) return f(Six{}, Six{});
-        if (rb == 3 && cb == 6) return f(Three{}, Six{});
-        if (rb == 6 && cb == 3) return f(Six{}, Three{});
-        if (rb == 3 && cb == 3) return f(Three{}, Three{});
-        f(Any{}, Any{});
-    }
-    // y = M x on rows [r0, r1) (whole blocks)
-    void times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        with_sizes([&](auto B, auto C) { times_sized<B(), C()>(x, y, r0, r1); });
-    }
-    template <int B, int C>
-    void times_sized(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        const std::size_t b = B ? std::size_t(B) : std::size_t(rb), c = C ? std::size_t(C) : std::size_t(cb);
-        double s[kModes];
-        for (std::size_t I = r0 / b; I < r1 / b; ++I) {
-            std::fill(s, s + b, 0.0);
-            for (int k = start[I]; k < start[I + 1]; ++k) {
-                const float* v = &val[std::size_t(k) * b * c];
-                const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
-                for (std::size_t i = 0; i < b; ++i)
-                    for (std::size_t j = 0; j < c; ++j) s[i] += double(v[i * c + j]) * xj[j];
-            }
-            std::copy(s, s + b, y + I * b);
-        }
-    }
-    // y += M x on rows [r0, r1) (whole blocks), each y_i updated by fused
-    // multiply-adds in increasing column order: bitwise transposed()'s
-    // transpose_add(x, y).
-    void times_add(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        with_sizes([&](auto B, auto C) { fused_rows<B(), C(), true>(x, y, r0, r1); });
-    }
-    // y = M^T x, scattered row by row. Fused multiply-adds, spelt out:
-    // gather_times on the stored transpose adds the same terms in the same
-    // order, and the two must round alike (g++ fused the scatter's update on
-    // its own and not the gather's sum).
-    void transpose_times(const double* x, double* y) const {
-        std::fill(y, y + cols, 0.0);
-        transpose_add(x, y);
-    }
-    // y += M^T x, the same scatter.
-    void transpose_add(const double* x, double* y) const {
-        with_sizes([&](auto B, auto C) { transpose_add_sized<B(), C()>(x, y); });
-    }
-    template <int B, int C>
-    void transpose_add_sized(const double* x, double* y) const {
-        const std::size_t b = B ? std::size_t(B) : std::size_t(rb), c = C ? std::size_t(C) : std::size_t(cb);
-        // each y_j gets block row I's terms in row order, summed in a
-        // register (the order of the row-by-row scatter, without a store
-        // and reload between the rows)
-        for (std::size_t I = 0; I + 1 < start.size(); ++I) {
-            const double* xi = x + I * b;
-            for (int k = start[I]; k < start[I + 1]; ++k) {
-                const float* v = &val[std::size_t(k) * b * c];
-                double* yj = y + std::size_t(col[std::size_t(k)]) * c;
-                for (std::size_t j = 0; j < c; ++j) {
-                    double t = yj[j];
-                    for (std::size_t i = 0; i < b; ++i) t = std::fma(double(v[i * c + j]), xi[i], t);
-                    yj[j] = t;
-                }
-            }
-        }
-    }
-    // Rows [r0, r1) of y = M x for M = transposed() of a matrix N: bitwise
-    // N.transpose_times(x, y) there.
-    void gather_times(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        with_sizes([&](auto B, auto C) { fused_rows<B(), C(), false>(x, y, r0, r1); });
-    }
-    // Rows [r0, r1) of y (+)= M x (Add: from y's values, else from zero),
-    // each y_i by fused multiply-adds in increasing column order.
-    template <int B, int C, bool Add>
-    void fused_rows(const double* x, double* y, std::size_t r0, std::size_t r1) const {
-        const std::size_t b = B ? std::size_t(B) : std::size_t(rb);
-        double s[kModes];
-        for (std::size_t I = r0 / b; I < r1 / b; ++I) {
-            if (Add) std::copy(y + I * b, y + I * b + b, s);
-            else std::fill(s, s + b, 0.0);
-            accumulate_row<B, C>(I, x, s);
-            std::copy(s, s + b, y + I * b);
-        }
-    }
-    // s_i += (M x)_i for the rows i of block row I, each by fused
-    // multiply-adds in increasing column order; the block's rows are
-    // interleaved (independent sums: no wait on one fma's latency), which
-    // changes no sum's order.
-    template <int B, int C>
-    void accumulate_row(std::size_t I, const double* x, double* s) const {
-        const std::size_t b = B ? std::size_t(B) : std::size_t(rb), c = C ? std::size_t(C) : std::size_t(cb);
-        for (int k = start[I]; k < start[I + 1]; ++k) {
-            const float* v = &val[std::size_t(k) * b * c];
-            const double* xj = x + std::size_t(col[std::size_t(k)]) * c;
-            for (std::size_t j = 0; j < c; ++j)
-                for (std::size_t i = 0; i < b; ++i) s[i] = std::fma(double(v[i * c + j]), xj[j], s[i]);
-        }
-    }
-    // M^T with each block row's blocks in increasing block column order:
-    // its row j times x adds the terms of column j in the order
-    // transpose_times adds them (bitwise the same y).
-    BlockRows transposed() const {
-        BlockRows t;
-        t.rows = cols;
-        t.cols = rows;
-        t.rb = cb;
-        t.cb = rb;
-        const std::size_t nbc = std::size_t(cols / cb), w = std::size_t(rb) * std::size_t(cb);
-        t.start.assign(nbc + 1, 0);
-        for (int J : col) ++t.start[std::size_t(J) + 1];
-        for (std::size_t J = 0; J < nbc; ++J) t.start[J + 1] += t.start[J];
-        t.col.resize(col.size());
-        t.val.resize(val.size());
-        std::vector<int> next(t.start.begin(), t.start.end() - 1);
-        for (std::size_t I = 0; I + 1 < start.size(); ++I)
-            for (int k = start[I]; k < start[I + 1]; ++k) {
-                const std::size_t at = std::size_t(next[std::size_t(col[std::size_t(k)])]++);
-                t.col[at] = int(I);
-                for (int i = 0; i < rb; ++i)
-                    for (int j = 0; j < cb; ++j)
-                        t.val[at * w + std::size_t(j) * std::size_t(rb) + std::size_t(i)] =
-                            val[std::size_t(k) * w + std::size_t(i) * std::size_t(cb) + std::size_t(j)];
-            }
-        return t;
-    }
-    SparseRows expand() const {
-        std::vector<Eigen::Triplet<double>> t;
-        t.reserve(val.size());
-        for (std::size_t I = 0; I + 1 < start.size(); ++I)
-            for (int k = start[I]; k < start[I + 1]; ++k)
-                for (int i = 0; i < rb; ++i)
-                    for (int j = 0; j < cb; ++j) {
-                        const float v = val[(std::size_t(k) * std::size_t(rb) + std::size_t(i)) * std::size_t(cb) + std::size_t(j)];
-                        if (v != 0) t.emplace_back(int(I) * rb + i, col[std::size_t(k)] * cb + j, double(v));
-                    }
-        SparseRows M(rows, cols);
-        M.setFromTriplets(t.begin(), t.end());
-        return M;
-    }
-    // Drops the blocks whose entries are all zero (assign() stores none).
-    void drop_zero_blocks() {
-        const std::size_t w = std::size_t(rb) * std::size_t(cb);
-        std::size_t kept = 0;
-        int first = 0;
-        for (std::size_t I = 0; I + 1 < start.size(); ++I) {
-            const int last = start[I + 1];
-            for (int k = first; k < last; ++k) {
-                const float* v = &val[std::size_t(k) * w];
-                if (std::all_of(v, v + w, [](float x) { return x == 0; })) continue;
-                col[kept] = col[std::size_t(k)];
-                std::copy(v, v + w, val.begin() + std::ptrdiff_t(kept * w));
-                ++kept;
-            }
-            first = last;
-            start[I + 1] = int(kept);
-        }
-        col.resize(kept);
-        val.resize(kept * w);
-        col.shrink_to_fit();
-        val.shrink_to_fit();
-    }
-    std::size_t bytes() const { return start.size() * sizeof(int) + col.size() * sizeof(int) + val.size() * sizeof(float); }
-};
 
 
 
@@ -649,11 +432,11 @@ struct SmoothedAggregation::Impl {
     struct Level {
         int bs = 3;
         BlockRows A;           // level >= 1 and not the coarsest: R A P of the level above
-        // The prolongator to the next level, held one way only: P with a
-        // serial executor, its transpose R = P^T with a threaded one (the
-        // restriction then a gather over R's rows in parallel, the
-        // prolongation a scatter from them; bitwise P's products).
-        BlockRows P, R;
+        // The prolongator to the next level, grouped by rows with a serial
+        // executor, by columns with a threaded one (the restriction then a
+        // gather over coarse rows in parallel, the prolongation a scatter;
+        // bitwise the serial products: amg/block_rows.hpp).
+        BlockRows P;
         SparseRows P_tent;     // before smoothing (build only; release_build_data() frees it)
         Eigen::MatrixXd B;     // near-nullspace, dofs x 6
         std::vector<index_t> agg;  // not the coarsest: each node's aggregate (its block column of P; rebuild())
@@ -671,20 +454,13 @@ struct SmoothedAggregation::Impl {
     std::shared_ptr<const Executor> ex;  // null or one thread: serial
 
     bool threaded() const { return ex && ex->threads() > 1; }
-    // Level L's prolongator in block rows: P where it holds P, else R's
-    // transpose made in `scratch`.
+    // Level L's prolongator grouped by rows: P, or P regrouped in `scratch`.
     static const BlockRows& prolongator(const Level& L, BlockRows& scratch) {
-        return L.P.rows > 0 ? L.P : (scratch = L.R.transposed());
+        return L.P.by_columns ? (scratch = L.P.regrouped()) : L.P;
     }
-    // Holds level L's prolongator the way the executor uses it.
+    // Groups level L's prolongator the way the executor uses it.
     void hold(Level& L) const {
-        if (threaded() && L.P.rows > 0) {
-            L.R = L.P.transposed();
-            L.P = BlockRows();
-        } else if (!threaded() && L.R.rows > 0) {
-            L.P = L.R.transposed();
-            L.R = BlockRows();
-        }
+        if (L.P.rows > 0 && L.P.by_columns != threaded()) L.P = L.P.regrouped();
     }
     // body(begin, end) over [0, n) in the fixed blocks of for_blocks (their
     // ends are multiples of 384: whole 3- and 6-dof nodes), on the executor.
@@ -810,8 +586,7 @@ struct SmoothedAggregation::Impl {
             if (!cheb) Dinv = block_inverse(*Al, L.bs, false);
             const std::vector<double>& D = cheb ? L.Minv : Dinv;
             const double rho = cheb ? L.lambda : largest_eigenvalue(*Al, D, L.bs, settings.power_iterations);
-            BlockRows P = L.P.rows > 0 ? std::move(L.P) : L.R.transposed();
-            L.R = BlockRows();
+            BlockRows P = L.P.by_columns ? L.P.regrouped() : std::move(L.P);
             const index_t count = index_t(P.cols / kModes);
             tentative_blocks(B, L.bs, Members(L.agg, count), l == 0 ? free.data() : nullptr, Qn, Bc);
             const double f = settings.prolongator_weight / rho;  // w / rho (w = 4/3 by default)
@@ -843,7 +618,6 @@ struct SmoothedAggregation::Impl {
         std::vector<index_t> agg = aggregate(node_graph(Al, bs, l == 0 ? 0.0 : settings.strength), count);
         if (Eigen::Index(count) * kModes >= Al.rows()) return;
         level[l].P = prolongator_pattern(Al, bs, agg, count);
-        level[l].R = BlockRows();
         level[l].agg = std::move(agg);
         level.emplace_back();
         level.back().bs = kModes;
@@ -870,18 +644,18 @@ struct SmoothedAggregation::Impl {
         residual(L, b, x, product);
         const double* r = L.r.data();
         const Level& C = level[l + 1];
-        const bool gather = L.R.rows > 0;  // threaded: R (build(), set_executor())
-        C.b.resize(gather ? L.R.rows : L.P.cols);
+        const bool gather = L.P.by_columns;  // threaded (build(), set_executor())
+        C.b.resize(L.P.cols);
         if (gather)
-            par(L.R.rows, [&](std::size_t i0, std::size_t i1) { L.R.gather_times(r, C.b.data(), i0, i1); });
+            par(L.P.cols, [&](std::size_t i0, std::size_t i1) { amg::restrict_gather(L.P, r, C.b.data(), i0, i1); });
         else
-            L.P.transpose_times(r, C.b.data());
+            amg::restrict_scatter(L.P, r, C.b.data());
         C.x.resize(C.b.size());
         cycle(l + 1, C.b.data(), C.x.data(), fine);
         if (gather)
-            L.R.transpose_add(C.x.data(), x);
+            amg::prolong_scatter(L.P, C.x.data(), x);
         else
-            L.P.times_add(C.x.data(), x, 0, std::size_t(L.P.rows));
+            amg::prolong_gather(L.P, C.x.data(), x, 0, std::size_t(L.P.rows));
         smooth(L, b, x, false, product);
     }
 };
@@ -984,7 +758,7 @@ double SmoothedAggregation::cycle_cost() const {
     for (std::size_t l = 0; l + 1 < m.level.size(); ++l) {
         const Impl::Level& L = m.level[l];
         if (l > 0) coarse += products * entries(L.A);
-        coarse += 2 * (entries(L.P) + entries(L.R));  // one of them is held: restriction and prolongation
+        coarse += 2 * entries(L.P);  // restriction and prolongation
     }
     const double nc = double(dofs(levels() - 1));
     coarse += nc * nc;  // the two triangular solves with the dense factor
@@ -998,7 +772,7 @@ std::size_t SmoothedAggregation::bytes() const {
     const auto vec = [](const Eigen::VectorXd& v) { return std::size_t(v.size()) * sizeof(double); };
     std::size_t b = 0;
     for (const auto& L : impl_->level)
-        b += L.A.bytes() + L.P.bytes() + L.R.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
+        b += L.A.bytes() + L.P.bytes() + sp(L.P_tent) + std::size_t(L.B.size()) * sizeof(double) +
              L.Minv.size() * sizeof(double) + vec(L.x) + vec(L.b) + vec(L.r) + vec(L.d) + vec(L.t) + L.galerkin.bytes() +
              L.agg.size() * sizeof(index_t);
     b += impl_->coarse.bytes() + impl_->free.size();
