@@ -25,6 +25,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "edgefem/core/smoothed_aggregation.hpp"
 #include "solvers/preconditioner.hpp"
@@ -39,6 +40,8 @@ template <class S>
 class Amg final : public Preconditioner<S> {
 public:
     explicit Amg(const SimState<S>& state) : s_(state), ex_(state.backend->executor()), matrix_(state) {
+        for (std::size_t i = 0; i < s_.free_host.size(); ++i)
+            if (!s_.free_host[i]) fixed_.push_back(i);
         matrix_.keep(false, true);
         amg_.set_executor(ex_);  // the back-end's threads, bitwise as serial
     }
@@ -189,13 +192,9 @@ public:
 
     void apply(std::size_t lo, std::size_t hi, const double* r, double* z) const override {
         if (lo != 0 || hi != s_.n()) throw InvalidArgument("AMG preconditioner: applies to the whole vector only");
-        const auto& fr = s_.free_host;
         amg_.apply(r, z, [&](const double* x, double* y) {
             A_->apply(x, y);
-            for_blocks_if_threaded(ex_.get(), fr.size(), [&](std::size_t i0, std::size_t i1) {
-                for (std::size_t i = i0; i < i1; ++i)
-                    if (!fr[i]) y[i] = 0;
-            });
+            for (const std::size_t i : fixed_) y[i] = 0;  // the hierarchy's rows of fixed dofs are zero
         });
     }
 
@@ -248,6 +247,7 @@ private:
     std::shared_ptr<const Executor> ex_;  // the back-end's threads (null: serial)
     SystemMatrix<S> matrix_;
     SmoothedAggregation amg_;
+    std::vector<std::size_t> fixed_;  // the dofs free_host marks fixed (the finest products zero them)
     LinearSystem<S>* A_ = nullptr;
     bool built_ = false;
     std::array<double, 3> c_{};  // c_m, c_k, c_b at the last refresh
