@@ -55,23 +55,21 @@ inline void store(double* y, const Six& a) {
     std::memcpy(y + 4, &a.hi, sizeof a.hi);
 }
 
-// p[0] + ... + p[n - 1] in pairs: ((p0 + p1) + (p2 + p3)) + ...
-inline double pair_sum(const double* p, std::size_t n) {
-    double s = n > 1 ? p[0] + p[1] : p[0];
-    for (std::size_t m = 2; m < n; m += 2) s += m + 1 < n ? p[m] + p[m + 1] : p[m];
-    return s;
+// v[0] x[0] + v[s] x[1] + ... + v[(n - 1) s] x[n - 1], the products summed
+// in pairs: ((p0 + p1) + (p2 + p3)) + ...
+inline double pair_dot(const float* v, std::size_t s, const double* x, std::size_t n) {
+    const auto p = [&](std::size_t k) { return double(v[k * s]) * x[k]; };
+    double sum = n > 1 ? p(0) + p(1) : p(0);
+    for (std::size_t m = 2; m < n; m += 2) sum += m + 1 < n ? p(m) + p(m + 1) : p(m);
+    return sum;
 }
 
-// u = x^T V for an rb x cb block V (u has cb entries), the terms of each
-// u_j in pairs over the block's rows.
+// u = x^T V for an rb x cb block V (u has cb entries): each u_j a pair_dot
+// down column j.
 template <int B, int C>
 inline void restriction_part(const float* v, const double* x, std::size_t rb, std::size_t cb, double* u) {
     const std::size_t b = B ? std::size_t(B) : rb, c = C ? std::size_t(C) : cb;
-    double p[kMaxBlock] = {};
-    for (std::size_t j = 0; j < c; ++j) {
-        for (std::size_t i = 0; i < b; ++i) p[i] = double(v[i * c + j]) * x[i];
-        u[j] = pair_sum(p, b);
-    }
+    for (std::size_t j = 0; j < c; ++j) u[j] = pair_dot(v + j, c, x, b);
 }
 // The same, six wide (cb = 6), in the same pairs.
 template <int B>
@@ -82,15 +80,11 @@ inline Six restriction_six(const float* v, const double* x) {
                            : load_float(v + 6 * m) * x[m]);
     return s;
 }
-// t_i += (V x)_i for an rb x cb block V, each row's terms in pairs.
+// t_i += (V x)_i for an rb x cb block V: a pair_dot along row i.
 template <int B, int C>
 inline void prolongation_part(const float* v, const double* x, std::size_t rb, std::size_t cb, double* t) {
     const std::size_t b = B ? std::size_t(B) : rb, c = C ? std::size_t(C) : cb;
-    double p[kMaxBlock] = {};
-    for (std::size_t i = 0; i < b; ++i) {
-        for (std::size_t j = 0; j < c; ++j) p[j] = double(v[i * c + j]) * x[j];
-        t[i] += pair_sum(p, c);
-    }
+    for (std::size_t i = 0; i < b; ++i) t[i] += pair_dot(v + i * c, 1, x, c);
 }
 
 // Calls f(B, C) with the block sizes as compile-time constants where they
