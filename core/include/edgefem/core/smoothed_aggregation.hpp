@@ -14,9 +14,9 @@
 // products through a caller's function (the matrix-free per-edge K). On the
 // host: on an executor's threads when set_executor() gives one (the vector
 // passes, the smoothers' blocks, the coarse products and the transfers in
-// the fixed blocks of for_blocks; the prolongator then held as P^T, the
-// restriction a gather over its rows), bitwise the same for any executor
-// and thread count.
+// the fixed blocks of for_blocks; the prolongator then held grouped by
+// aggregates, the restriction a gather over them: core/src/amg/block_rows.hpp),
+// bitwise the same for any executor and thread count.
 #pragma once
 
 #include <Eigen/SparseCore>
@@ -42,8 +42,9 @@ public:
     // constrained dofs zero; positions: 3 coordinates per vertex (where the body is); free_dof: 1 on
     // unknowns. Builds the hierarchy with refresh(A)'s operators and smoothers.
     // Runs apply() and smooth() on `ex` (null: serial). With more than one
-    // thread the prolongators are held transposed (P^T instead of P, the
-    // same memory): the restriction a gather, the prolongation a scatter.
+    // thread the prolongators are held grouped by their block columns (the
+    // same blocks, the same memory): the restriction a gather, the
+    // prolongation a scatter.
     void set_executor(std::shared_ptr<const Executor> ex);
     void build(const SparseRows& A, const std::vector<double>& positions, const std::vector<std::uint8_t>& free_dof,
                const AmgSettings& settings = {});
