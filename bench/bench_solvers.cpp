@@ -22,6 +22,7 @@
 //                         [--threads N]  (the step part on the pool back-end's N threads; default serial)
 //                         [--amg-only]   (the matrix part without block-Jacobi: the largest meshes)
 //                         [--trace]      (the run part: each preconditioner's iterations, refreshes and ms per step, on stderr)
+//                         [--no-retain]  (freed memory back to the system, glibc's defaults: edgefem/core/retain_freed_memory.hpp)
 // (--amg-*: AmgSettings' fields, for the step and matrix parts, to study the
 // hierarchy; unset ones keep SolverSettings' defaults)
 #ifndef EDGEFEM_BENCH_HYPRE
@@ -50,6 +51,7 @@
 
 #include "bench_meshes.hpp"
 #include "edgefem/core/coefficients.hpp"
+#include "edgefem/core/retain_freed_memory.hpp"
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/smoothed_aggregation.hpp"
@@ -637,6 +639,7 @@ int main(int argc, char** argv) {
     std::vector<double> dts{1, 4, 10};
     int rounds = 9;
     std::string parts = "direct,step,matrix";
+    bool retain = true;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         const auto next = [&]() -> std::string {
@@ -659,6 +662,7 @@ int main(int argc, char** argv) {
             for (const std::string& y : split(next())) g_youngs.push_back(std::stod(y));
         }
         else if (a == "--no-hypre") g_no_hypre = true;
+        else if (a == "--no-retain") retain = false;
         else if (a == "--threads") g_threads = std::max(1, std::stoi(next()));
         else if (a == "--amg-only") g_amg_only = true;
         else if (a == "--trace") g_trace = true;
@@ -685,6 +689,11 @@ int main(int argc, char** argv) {
         }
     }
     std::printf("%s\n", describe(g_amg).c_str());
+    // As the edgefem program does: the AMG's refreshes reuse freed memory
+    // instead of faulting fresh pages in (--no-retain: glibc's defaults).
+    const bool retained = retain && edgefem::retain_freed_memory();
+    std::printf("freed memory %s (edgefem/core/retain_freed_memory.hpp)\n",
+                retained ? "kept for reuse" : "returned to the system (glibc's defaults)");
     if (parts.find("direct") != std::string::npos) bench_direct(rounds);
     if (parts.find("step") != std::string::npos) bench_steps(meshes, dts, rounds);
     if (parts.find("run") != std::string::npos) bench_runs(meshes, dts, rounds);

@@ -16,6 +16,7 @@
 #include "common.hpp"
 #include "evidence_commands.hpp"
 #include "edgefem/core/error.hpp"
+#include "edgefem/core/retain_freed_memory.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "sim_common.hpp"
 
@@ -47,6 +48,9 @@ int main(int argc, char** argv) {
     // A write past the file size limit (ulimit -f) is an error to report
     // (EFBIG), not a signal that kills the program mid-frame.
     std::signal(SIGXFSZ, SIG_IGN);
+    // The AMG's refreshes free and allocate megabytes each time: kept for
+    // reuse, not faulted in again (docs/parallel.md, "Set-up on a VM").
+    edgefem::retain_freed_memory();
     bool no_memory_check = false;
     app.add_flag("--no-memory-check", no_memory_check,
                  "Build models even when their estimated memory (1000 bytes per tet) exceeds what is available "
