@@ -20,6 +20,7 @@
 #include "edgefem/core/error.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/retain_freed_memory.hpp"
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/surface.hpp"
@@ -220,6 +221,8 @@ std::size_t dofs(const edgefem_sim* sim) { return 3 * std::size_t(sim->sim.num_v
 extern "C" {
 
 const char* edgefem_version_string(void) { return EDGEFEM_VERSION; }
+
+int edgefem_retain_freed_memory(void) { return edgefem::retain_freed_memory() ? 1 : 0; }
 
 const char* edgefem_last_error(void) { return g_last_error.c_str(); }
 

@@ -32,6 +32,7 @@
 #include "edgefem/core/finite_input.hpp"
 #include "edgefem/core/make_box.hpp"
 #include "edgefem/core/read_mesh.hpp"
+#include "edgefem/core/retain_freed_memory.hpp"
 #include "edgefem/core/scene_json.hpp"
 #include "edgefem/core/simulator.hpp"
 #include "edgefem/core/surface.hpp"
@@ -395,6 +396,11 @@ PYBIND11_MODULE(_edgefem, m) {
         },
         py::arg("path"), py::arg("validate") = true,
         "Reads a TetGen .node/.ele (or prefix), Gmsh .msh, MEDIT .mesh, Vega .veg, or 'box:NXxNYxNZ'.");
+    m.def("retain_freed_memory", &retain_freed_memory,
+          "Keeps the memory this process frees for its own reuse (glibc: malloc's trim threshold 512 MiB, mmap "
+          "threshold 32 MiB) rather than handing it back, where the AMG's refreshes would fault it in again "
+          "(docs/parallel.md). Process-wide; the peak memory does not change. True where it changed malloc's "
+          "settings; False without glibc or where GLIBC_TUNABLES sets a glibc.malloc tunable.");
     m.def("make_box", &make_box, py::arg("nx"), py::arg("ny"), py::arg("nz"), py::arg("cell") = 0.01,
           "A box of nx x ny x nz cubes of side `cell` (6 tets each), centred at the origin.");
     m.def("make_box_of_size", &make_box_of_size, py::arg("target_tets"),

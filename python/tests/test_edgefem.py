@@ -320,3 +320,22 @@ def test_bad_run_options_name_themselves(kw, name):
     if name in ("backend", "threads", "variant") and "ordering" not in kw:
         with pytest.raises(edgefem.InvalidArgument, match=name):
             edgefem.ElasticModel(small_box(), **{k: v for k, v in kw.items() if k in ("backend", "threads", "variant")})
+
+
+def test_retain_freed_memory_leaves_a_users_malloc_tunables_alone(monkeypatch):
+    monkeypatch.setenv("GLIBC_TUNABLES", "glibc.malloc.check=0")
+    assert edgefem.retain_freed_memory() is False
+
+
+def test_retain_freed_memory_changes_glibcs_settings_in_a_fresh_process():
+    # A child process, so that this one's malloc keeps glibc's defaults.
+    import platform
+    import subprocess
+    import sys
+
+    if platform.libc_ver()[0] != "glibc":
+        pytest.skip("glibc only")
+    env = {k: v for k, v in os.environ.items() if k != "GLIBC_TUNABLES"}
+    out = subprocess.run([sys.executable, "-c", "import edgefem; print(edgefem.retain_freed_memory())"],
+                         env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "True"

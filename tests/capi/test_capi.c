@@ -1,6 +1,7 @@
 /* The C API from C11: the paper's 1,200-tet box built from arrays, clamped
  * at its x = min end, sagging under gravity; then the error paths. Prints
  * "test_capi: ok" and exits 0 on success. */
+#define _POSIX_C_SOURCE 200112L /* setenv, unsetenv */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -282,6 +283,13 @@ static void test_embedding(void) {
 
 int main(void) {
     printf("edgefem %s, C API %d\n", edgefem_version_string(), EDGEFEM_C_API_VERSION);
+    /* A user's malloc tunables are left alone; else, with glibc's own malloc, it changes the settings. */
+    setenv("GLIBC_TUNABLES", "glibc.malloc.check=0", 1);
+    CHECK(edgefem_retain_freed_memory() == 0);
+    unsetenv("GLIBC_TUNABLES");
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+    CHECK(edgefem_retain_freed_memory() == 1);
+#endif
     double* X;
     int32_t* T;
     int32_t nv, nt;

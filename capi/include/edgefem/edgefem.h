@@ -141,6 +141,14 @@ EDGEFEM_C_EXPORT const char* edgefem_version_string(void);
 EDGEFEM_C_EXPORT const char* edgefem_last_error(void);
 /** A short name for a status code, e.g. "EDGEFEM_ERROR_MESH" (static storage). */
 EDGEFEM_C_EXPORT const char* edgefem_status_string(edgefem_status status);
+/** Keeps the memory this process frees for its own reuse (glibc: malloc's
+ *  trim threshold at 512 MiB, its mmap threshold at 32 MiB) rather than
+ *  handing it back to the system, where the AMG's refreshes would fault it
+ *  in again (docs/parallel.md, "Set-up on a VM: page faults"). The peak
+ *  memory does not change. Process-wide: call it from the program's main(),
+ *  not from a library. Returns 1 where it changed malloc's settings, 0
+ *  without glibc or where GLIBC_TUNABLES sets a glibc.malloc tunable. */
+EDGEFEM_C_EXPORT int edgefem_retain_freed_memory(void);
 
 /* ---- Scenes ------------------------------------------------------------ */
 
